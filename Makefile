@@ -1,0 +1,42 @@
+# haptic_dob: the two commands of the README, plus a few helpers.
+#   make demo   create .venv, install, run the default simulated virtual-wall session
+#   make test   install if needed, run the whole test suite
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+# files copied into the environment at install time (ament index, package.xml, shims, config)
+INSTALLED_DATA := $(shell find ros config -type f 2>/dev/null)
+
+.PHONY: demo test install lint bench lock clean
+
+demo: $(STAMP)
+	@$(BIN)/haptic-demo
+
+test: $(STAMP)
+	@$(BIN)/python -m pytest -q -p no:cacheprovider
+
+install: $(STAMP)
+
+$(STAMP): pyproject.toml constraints.txt $(INSTALLED_DATA)
+	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	@echo "installing haptic_dob into $(VENV) (first run takes about a minute)"
+	@PIP_CONSTRAINT=$(CURDIR)/constraints.txt $(BIN)/python -m pip install -qq \
+		--disable-pip-version-check -e '.[dev]'
+	@touch $@
+
+lint: $(STAMP)
+	@$(BIN)/ruff check src test scripts
+	@$(BIN)/ruff format --check src test scripts
+
+bench: $(STAMP)
+	@$(BIN)/python scripts/benchmarks.py
+
+# Re-resolve the dependency set and rewrite constraints.txt (review the diff).
+lock:
+	@$(PYTHON) -m venv /tmp/haptic-dob-lock && /tmp/haptic-dob-lock/bin/pip install -qq \
+		--dry-run --ignore-installed --report /tmp/haptic-dob-lock.json -e '.[dev]'
+	@$(PYTHON) scripts/write_constraints.py /tmp/haptic-dob-lock.json constraints.txt
+
+clean:
+	rm -rf $(VENV) build dist .pytest_cache .ruff_cache

@@ -1,0 +1,180 @@
+"""Declarative parameters: one table per settings dataclass, used by nodes, YAML and batch runs.
+
+A settings dataclass marks each field with ``param(...)`` metadata (description, unit, range,
+choices, read-only). ``specs_of`` turns the fields into ``ParamSpec`` rows; nodes declare them as
+ROS 2 parameters with descriptors (``haptic_msgs_py.ros.params``), and ``build`` turns a mapping of
+parameter values (a node's parameters or a ``ros__parameters`` YAML section) back into the
+dataclass, so a node and a batch run read the same names, defaults and limits.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from enum import Enum
+from typing import Any
+
+ParamValue = bool | int | float | str | list[float] | list[str]
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """One parameter: name, default, description, unit, limits and whether it is read-only."""
+
+    name: str
+    default: ParamValue
+    description: str
+    unit: str = ""
+    min: float | None = None
+    max: float | None = None
+    choices: tuple[str, ...] = ()
+    read_only: bool = False
+
+    @property
+    def kind(self) -> type:
+        """Python type of the value: bool, int, float, str or list."""
+        d = self.default
+        return list if isinstance(d, (list, tuple)) else type(d)
+
+    def full_description(self) -> str:
+        """Description with unit, range and choices, as shown by ``ros2 param describe``."""
+        parts = [self.description]
+        if self.unit:
+            parts.append(f"[{self.unit}]")
+        if self.choices:
+            parts.append("one of: " + ", ".join(self.choices))
+        return " ".join(parts)
+
+    def check(self, value: Any) -> str | None:
+        """Return why ``value`` is refused, or None when it is acceptable."""
+        kind = self.kind
+        if kind is bool:
+            if not isinstance(value, bool):
+                return f"{self.name} must be a bool, got {value!r}"
+            return None
+        if kind is int:
+            if isinstance(value, bool) or not isinstance(value, int):
+                return f"{self.name} must be an integer, got {value!r}"
+            return self._range(float(value))
+        if kind is float:
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                return f"{self.name} must be a number, got {value!r}"
+            if not math.isfinite(float(value)):
+                return f"{self.name} must be finite, got {value!r}"
+            return self._range(float(value))
+        if kind is str:
+            if not isinstance(value, str):
+                return f"{self.name} must be a string, got {value!r}"
+            if self.choices and value not in self.choices:
+                return f"{self.name} must be one of {', '.join(self.choices)}, got {value!r}"
+            return None
+        # arrays
+        if isinstance(value, (str, bytes)) or not hasattr(value, "__len__"):
+            return f"{self.name} must be an array, got {value!r}"
+        items = list(value)
+        default = list(self.default)  # type: ignore[arg-type]
+        if default and len(items) != len(default):
+            return f"{self.name} must have {len(default)} elements, got {len(items)}"
+        if default and isinstance(default[0], str):
+            if not all(isinstance(v, str) for v in items):
+                return f"{self.name} must be an array of strings"
+            return None
+        for v in items:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                return f"{self.name} must be an array of finite numbers, got {items!r}"
+        return None
+
+    def _range(self, x: float) -> str | None:
+        unit = f" {self.unit}" if self.unit else ""
+        if self.min is not None and x < self.min:
+            return f"{self.name} must be >= {self.min:g}{unit}, got {x:g}"
+        if self.max is not None and x > self.max:
+            return f"{self.name} must be <= {self.max:g}{unit}, got {x:g}"
+        return None
+
+
+def param(
+    description: str,
+    unit: str = "",
+    min: float | None = None,
+    max: float | None = None,
+    choices: tuple[str, ...] = (),
+    read_only: bool = False,
+) -> dict[str, Any]:
+    """Field metadata of a settings dataclass (``field(default=1.0, metadata=param(...))``)."""
+    return {
+        "param": {
+            "description": description,
+            "unit": unit,
+            "min": min,
+            "max": max,
+            "choices": tuple(choices),
+            "read_only": read_only,
+        }
+    }
+
+
+def specs_of(cls: type, prefix: str = "", read_only: bool | None = None) -> list[ParamSpec]:
+    """The ``ParamSpec`` rows of a settings dataclass's annotated fields, names prefixed.
+
+    ``read_only`` overrides every field's own flag when given (structural groups).
+    """
+    out = []
+    for f in dataclasses.fields(cls):
+        meta = f.metadata.get("param")
+        if meta is None:
+            continue
+        missing = f.default is dataclasses.MISSING
+        default = f.default_factory() if missing else f.default  # type: ignore[misc]
+        if isinstance(default, tuple):
+            default = list(default)
+        elif isinstance(default, Enum):
+            default = default.value
+        out.append(
+            ParamSpec(
+                name=prefix + f.name,
+                default=default,
+                description=meta["description"],
+                unit=meta["unit"],
+                min=meta["min"],
+                max=meta["max"],
+                choices=meta["choices"],
+                read_only=meta["read_only"] if read_only is None else read_only,
+            )
+        )
+    return out
+
+
+def build(cls: type, values: Mapping[str, Any], prefix: str = "") -> Any:
+    """Instantiate settings dataclass ``cls`` from ``values`` (keys ``prefix + field``).
+
+    Missing keys keep the dataclass defaults; arrays become tuples. Raises ``ValueError`` with the
+    first refused value's reason.
+    """
+    kwargs: dict[str, Any] = {}
+    for spec in specs_of(cls, prefix):
+        if spec.name not in values:
+            continue
+        value = values[spec.name]
+        if spec.kind is float and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        reason = spec.check(value)
+        if reason:
+            raise ValueError(reason)
+        if spec.kind is list:
+            value = tuple(value)
+        kwargs[spec.name[len(prefix) :]] = value
+    return cls(**kwargs)
+
+
+def values_of(obj: Any, prefix: str = "") -> dict[str, ParamValue]:
+    """The parameter values of a settings dataclass instance (inverse of ``build``)."""
+    out: dict[str, ParamValue] = {}
+    for spec in specs_of(type(obj), prefix):
+        v = getattr(obj, spec.name[len(prefix) :])
+        if isinstance(v, Enum):
+            v = v.value
+        out[spec.name] = list(v) if isinstance(v, tuple) else v
+    return out

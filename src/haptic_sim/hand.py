@@ -1,0 +1,216 @@
+"""The simulated human hand: a mass-spring-damper grip coupled to a reference motion.
+
+The hand holds the handle: its mass ``m_h`` moves with the device, and a spring ``k_h`` and damper
+``b_h`` pull it toward a reference position ``x_r(t)`` that the "person" moves. The force on the
+device (what a handle force sensor reads) is ``F_h = k_h (x_r - x) + b_h (x_r' - x') + f_ff(t)
+- m_h x''``; ``f_ff`` is an additional feed-forward force (the perturbation of the vibration
+protocol). All quantities act along the device's axis (1-D) and are SI.
+
+Behaviours (``HandParams.behaviour``):
+
+- ``semi_random``: ``x_r = ramp(t) * offset + amplitude * n(t)``, ``n`` unit-variance Gaussian
+  noise band-limited to [band_low_hz, band_high_hz] (4th-order Butterworth band-pass, zero mean),
+  the thesis's "semi-random" transparency excitation (40 s per run).
+- ``push_hold``: ``x_r = ramp(t) * offset`` held, plus a rectangular force pulse of
+  ``perturbation_n`` lasting ``perturbation_s`` at ``perturbation_at_s``: the vibration protocol.
+- ``none``: no hand (zero force; the device moves only under its actuator).
+
+The reference is generated block by block from a seeded generator, so an unbounded real-time run
+and a batch run of the same seed see the same hand.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import signal
+
+from haptic_dob.validation import finite_scalar, nonnegative, positive
+from haptic_msgs_py.params import param
+
+BEHAVIOURS = ("semi_random", "push_hold", "none")
+
+
+@dataclass(frozen=True)
+class HandParams:
+    """Hand grip and reference-motion settings (SI units; see the module docstring)."""
+
+    behaviour: str = field(
+        default="semi_random",
+        metadata=param("what the simulated hand does", choices=BEHAVIOURS, read_only=True),
+    )
+    mass_kg: float = field(
+        default=0.1, metadata=param("hand mass moving with the handle", "kg", 0.0, 10.0)
+    )
+    stiffness_n_per_m: float = field(
+        default=300.0, metadata=param("grip stiffness toward the reference", "N/m", 0.0, 1e5)
+    )
+    damping_n_s_per_m: float = field(
+        default=10.0, metadata=param("grip damping toward the reference", "N s/m", 0.0, 1e3)
+    )
+    offset_m: float = field(
+        default=0.0091667, metadata=param("reference push past the start position", "m", -1.0, 1.0)
+    )
+    amplitude_m: float = field(
+        default=0.0011458, metadata=param("std of the semi-random reference motion", "m", 0.0, 1.0)
+    )
+    band_low_hz: float = field(
+        default=0.05, metadata=param("low edge of the semi-random motion band", "Hz", 1e-3, 1e3)
+    )
+    band_high_hz: float = field(
+        default=10.0, metadata=param("high edge of the semi-random motion band", "Hz", 1e-3, 1e3)
+    )
+    ramp_s: float = field(
+        default=1.0, metadata=param("smooth ramp-in time of the reference", "s", 0.0, 1e3)
+    )
+    perturbation_n: float = field(
+        default=0.0, metadata=param("push_hold: force pulse amplitude", "N", -100.0, 100.0)
+    )
+    perturbation_at_s: float = field(
+        default=1.5, metadata=param("push_hold: pulse start time", "s", 0.0, 1e6)
+    )
+    perturbation_s: float = field(
+        default=0.005, metadata=param("push_hold: pulse duration", "s", 0.0, 10.0)
+    )
+
+    def __post_init__(self) -> None:
+        if self.behaviour not in BEHAVIOURS:
+            raise ValueError(
+                f"behaviour must be one of {', '.join(BEHAVIOURS)}, got {self.behaviour!r}"
+            )
+        nonnegative("mass_kg", self.mass_kg)
+        nonnegative("stiffness_n_per_m", self.stiffness_n_per_m)
+        nonnegative("damping_n_s_per_m", self.damping_n_s_per_m)
+        finite_scalar("offset_m", self.offset_m)
+        nonnegative("amplitude_m", self.amplitude_m)
+        lo, hi = (
+            positive("band_low_hz", self.band_low_hz),
+            positive("band_high_hz", self.band_high_hz),
+        )
+        if lo >= hi:
+            raise ValueError(f"band_low_hz ({lo}) must be below band_high_hz ({hi})")
+        nonnegative("ramp_s", self.ramp_s)
+        finite_scalar("perturbation_n", self.perturbation_n)
+        nonnegative("perturbation_at_s", self.perturbation_at_s)
+        nonnegative("perturbation_s", self.perturbation_s)
+
+    @property
+    def active(self) -> bool:
+        """False for ``behaviour='none'``."""
+        return self.behaviour != "none"
+
+
+#: default session push and force swing of the semi-random hand (N)
+DEFAULT_PUSH_N = 2.0
+DEFAULT_FORCE_STD_N = 0.25
+
+
+def reference_for_force(
+    wall_stiffness_n_per_m: float,
+    hand_stiffness_n_per_m: float,
+    push_force_n: float = DEFAULT_PUSH_N,
+    force_std_n: float = DEFAULT_FORCE_STD_N,
+) -> tuple[float, float]:
+    """Reference offset and amplitude (m) for a mean push and a quasi-static force swing (N).
+
+    A person regulates force, not position: against a stiffer wall they move less. With the grip
+    spring k_h in series with the wall K the static compliance is ``1/K + 1/k_h``; offset and
+    amplitude are the push and the swing times that compliance. (Dynamics add to the swing near
+    the hand-device resonance; the defaults keep contact over 99 % of a session at 80-2400 N/m.)
+    """
+    k_h = positive("hand_stiffness_n_per_m", hand_stiffness_n_per_m)
+    k_w = nonnegative("wall_stiffness_n_per_m", wall_stiffness_n_per_m)
+    push = finite_scalar("push_force_n", push_force_n)
+    std = nonnegative("force_std_n", force_std_n)
+    compliance = 1.0 / k_h + (1.0 / k_w if k_w > 0.0 else 0.0)
+    return push * compliance, std * compliance
+
+
+def _band_filter(params: HandParams, dt: float) -> np.ndarray:
+    """The reference's band-pass (4th-order Butterworth) at sample period ``dt`` (s)."""
+    nyq = 0.5 / dt
+    return signal.butter(
+        4, [params.band_low_hz / nyq, params.band_high_hz / nyq], btype="bandpass", output="sos"
+    )
+
+
+class HandReference:
+    """Block-wise generator of the reference position, velocity and feed-forward force.
+
+    Args:
+        params: the hand's settings.
+        dt: sample period of the reference (s), the plant's physics step.
+        rng: the random generator (seeded by the caller).
+        block_s: length of one generated block (s).
+    """
+
+    def __init__(
+        self, params: HandParams, dt: float, rng: np.random.Generator, block_s: float = 1.0
+    ) -> None:
+        self.params = params
+        self.dt = positive("dt", dt)
+        self._rng = rng
+        self._block = max(1, round(block_s / dt))
+        self._start = 0
+        self._pos = np.zeros(self._block)
+        self._vel = np.zeros(self._block)
+        self._ff = np.zeros(self._block)
+        self._last_x = 0.0
+        self._sos = None
+        self._zi = None
+        self._scale = 0.0
+        if params.behaviour == "semi_random" and params.amplitude_m > 0.0:
+            self._sos = _band_filter(params, dt)
+            self._zi = np.zeros((self._sos.shape[0], 2))
+            self._scale = params.amplitude_m / _noise_gain(self._sos, dt, params.band_low_hz)
+        self._fill(0)
+
+    def arrays(self, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """(position, velocity, feed-forward force) arrays holding sample ``i``, and its index.
+
+        Samples are generated strictly in order; ``i`` must not go back before the current block.
+        """
+        while i >= self._start + self._block:
+            self._fill(self._start + self._block)
+        if i < self._start:
+            raise ValueError(f"hand reference sample {i} is before the current block")
+        return self._pos, self._vel, self._ff, i - self._start
+
+    def _fill(self, start: int) -> None:
+        p = self.params
+        n = self._block
+        t = (start + np.arange(n)) * self.dt
+        if p.ramp_s > 0.0:
+            ramp = np.where(
+                t < p.ramp_s, 0.5 - 0.5 * np.cos(np.pi * np.minimum(t / p.ramp_s, 1.0)), 1.0
+            )
+        else:
+            ramp = np.ones(n)
+        pos = ramp * p.offset_m if p.active else np.zeros(n)
+        if self._sos is not None:
+            noise, self._zi = signal.sosfilt(self._sos, self._rng.standard_normal(n), zi=self._zi)
+            pos = pos + self._scale * ramp * noise
+        prev = np.concatenate(([self._last_x], pos[:-1]))
+        self._vel = (pos - prev) / self.dt
+        self._last_x = float(pos[-1])
+        self._pos = pos
+        ff = np.zeros(n)
+        if p.behaviour == "push_hold" and p.perturbation_n != 0.0 and p.perturbation_s > 0.0:
+            on = (t >= p.perturbation_at_s) & (t < p.perturbation_at_s + p.perturbation_s)
+            ff[on] = p.perturbation_n
+        self._ff = ff
+        self._start = start
+
+
+def _noise_gain(sos: np.ndarray, dt: float, low_hz: float) -> float:
+    """Standard deviation of the filter's output for unit white noise at period ``dt`` (s).
+
+    ``sigma^2 = 2 dt * integral_0^{fs/2} |H(f)|^2 df``, integrated on a log-spaced grid dense
+    around the pass band.
+    """
+    fs = 1.0 / dt
+    f = np.geomspace(low_hz * 1e-3, fs / 2.0, 200_000)
+    _, h = signal.sosfreqz(sos, worN=f, fs=fs)
+    return math.sqrt(2.0 * dt * float(np.trapezoid(np.abs(h) ** 2, f)))

@@ -1,0 +1,287 @@
+"""The batch runner: one simulated session in-process, with the node graph's exact cycle timing.
+
+Per cycle k, in the order the node graph runs them:
+
+1. the device reports sample k (``SimulatedSlide.sample``);
+2. the environment computes the wall force from the end-effector pose and twist of sample k;
+3. the observer updates with sample k (positions, velocities, effort applied over [k-1, k));
+4. the controller computes command k from the stamp-k inputs its mode needs;
+5. the device holds command k over [k, k+1) and steps to k+1.
+
+Deterministic for a given seed; the node graph in lockstep reproduces it to the bit.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from haptic_dob.analysis.energy import passivity_observer
+from haptic_dob.analysis.transparency import transparency
+from haptic_dob.control import ImpedanceController, ImpedanceLaw
+from haptic_dob.environment import VirtualWall
+from haptic_dob.models.slide import SlideParams
+from haptic_dob.observer import ObserverSettings
+from haptic_dob.validation import nonnegative, positive
+from haptic_msgs_py.params import build, param
+from haptic_sim.hand import HandParams
+from haptic_sim.sensor import ForceSensorParams
+from haptic_sim.slide import SimulatedSlide, SlideDeviceParams
+
+
+@dataclass(frozen=True)
+class LoopSettings:
+    """Rate, physics sub-steps, length and seed of a simulated session."""
+
+    rate_hz: float = field(
+        default=1000.0, metadata=param("control rate", "Hz", 1.0, 1e5, read_only=True)
+    )
+    substeps: int = field(
+        default=10, metadata=param("physics steps per control period", "", 1, 1000, read_only=True)
+    )
+    duration_s: float = field(
+        default=40.0, metadata=param("session length; 0 = until stopped", "s", 0.0, 1e7)
+    )
+    seed: int = field(
+        default=0,
+        metadata=param(
+            "seed of the hand motion and sensor noise", "", 0, 2**31 - 1, read_only=True
+        ),
+    )
+
+    def __post_init__(self) -> None:
+        positive("rate_hz", self.rate_hz)
+        nonnegative("duration_s", self.duration_s)
+        if self.substeps < 1:
+            raise ValueError(f"substeps must be >= 1, got {self.substeps}")
+
+
+@dataclass(frozen=True)
+class SessionConfig:
+    """Everything a simulated slide session needs (each part is a parameter group of a node).
+
+    ``model`` is the slide's true physics (device node) and, unless ``observer_model`` is given,
+    also the observer's model (a perfect model).
+    """
+
+    loop: LoopSettings = field(default_factory=LoopSettings)
+    model: SlideParams = field(default_factory=SlideParams)
+    device: SlideDeviceParams = field(default_factory=SlideDeviceParams)
+    sensor: ForceSensorParams = field(default_factory=ForceSensorParams)
+    hand: HandParams = field(default_factory=HandParams)
+    wall: VirtualWall = field(default_factory=VirtualWall)
+    law: ImpedanceLaw = field(default_factory=ImpedanceLaw)
+    observer: ObserverSettings = field(default_factory=ObserverSettings)
+    observer_model: SlideParams | None = None
+
+    def replace(self, **groups: Any) -> SessionConfig:
+        """A copy with whole groups replaced, or single fields as ``group__field=value``."""
+        direct = {k: v for k, v in groups.items() if "__" not in k}
+        cfg = dataclasses.replace(self, **direct)
+        nested: dict[str, dict[str, Any]] = {}
+        for key, value in groups.items():
+            if "__" in key:
+                g, f = key.split("__", 1)
+                nested.setdefault(g, {})[f] = value
+        for g, fields_ in nested.items():
+            cfg = dataclasses.replace(cfg, **{g: dataclasses.replace(getattr(cfg, g), **fields_)})
+        return cfg
+
+    @classmethod
+    def from_node_params(cls, nodes: Mapping[str, Mapping[str, Any]]) -> SessionConfig:
+        """Build from per-node parameter dicts (``device_node``, ``environment_node``, ...).
+
+        Keys follow the nodes' parameter names (``slide.mass_kg``, ``hand.offset_m``,
+        ``stiffness_n_per_m``, ``mode``, ``gain``...); ``/**`` applies to every node.
+        """
+        common = dict(nodes.get("/**", {}))
+
+        def of(name: str) -> dict[str, Any]:
+            return {**common, **dict(nodes.get(name, {}))}
+
+        dev, env, obs, ctl = (
+            of("device_node"),
+            of("environment_node"),
+            of("observer_node"),
+            of("controller_node"),
+        )
+        model = build(SlideParams, dev, "slide.")
+        obs_model = build(SlideParams, obs, "slide.")
+        return cls(
+            loop=build(LoopSettings, dev),
+            model=model,
+            device=build(SlideDeviceParams, dev, "plant."),
+            sensor=build(ForceSensorParams, dev, "sensor."),
+            hand=build(HandParams, dev, "hand."),
+            wall=build(VirtualWall, env),
+            law=build(ImpedanceLaw, ctl),
+            observer=build(ObserverSettings, obs),
+            observer_model=None if obs_model == model else obs_model,
+        )
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> SessionConfig:
+        """Load a ``ros__parameters`` YAML file (the one the node graph is launched with)."""
+        import yaml
+
+        with open(path, encoding="utf-8") as fh:
+            doc = yaml.safe_load(fh) or {}
+        if not isinstance(doc, dict):
+            raise ValueError(f"{path}: expected a mapping of node names to ros__parameters")
+        nodes = {}
+        for name, body in doc.items():
+            params = (body or {}).get("ros__parameters", {}) if isinstance(body, dict) else {}
+            nodes[str(name).rsplit("/", 1)[-1] if name != "/**" else "/**"] = _flatten(params)
+        return cls.from_node_params(nodes)
+
+
+def _flatten(d: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Nested YAML mappings to ROS's dotted parameter names."""
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        if isinstance(v, Mapping):
+            out.update(_flatten(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+@dataclass
+class SessionResult:
+    """Per-cycle arrays of a session (SI units), all of length N (one row per cycle k).
+
+    Positions, velocities and forces are along the slide's axis (scalars); ``command`` is the
+    effort command k, ``effort`` the effort the actuator applied over [k-1, k).
+    """
+
+    config: SessionConfig
+    t: np.ndarray
+    x_true: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    effort: np.ndarray
+    command: np.ndarray
+    wall_force: np.ndarray
+    hand_force: np.ndarray
+    force_measured: np.ndarray
+    force_estimated: np.ndarray
+
+    @property
+    def dt(self) -> float:
+        """Control period (s)."""
+        return 1.0 / self.config.loop.rate_hz
+
+    def summary(self, settle_s: float = 2.0) -> dict[str, Any]:
+        """Headline figures: transparency, force-estimate error, contact, saturation, energy.
+
+        The first ``settle_s`` seconds (the hand's ramp-in; at most a quarter of the session) are
+        left out. Transparency figures are None when the record is too short or does not move.
+        """
+        cfg = self.config
+        fs = cfg.loop.rate_hz
+        s = slice(min(round(settle_s * fs), self.t.size // 4), None)
+        out: dict[str, Any] = {
+            "controller": cfg.law.mode.value,
+            "kf": cfg.law.kf,
+            "stiffness_n_per_m": cfg.wall.stiffness_n_per_m,
+            "observer_gain": cfg.observer.gain,
+            "duration_s": self.t.size / fs,
+            "seed": cfg.loop.seed,
+        }
+        err = self.force_estimated[s] - self.hand_force[s]
+        out["estimate_rms_error_n"] = float(np.sqrt(np.mean(err * err)))
+        out["saturated_pct"] = float(
+            np.mean(np.abs(self.effort[s]) >= cfg.device.max_force_n * (1 - 1e-9)) * 100.0
+        )
+        depth = self.q[s] - float(np.dot(cfg.wall.position, cfg.wall.normal))
+        out["in_contact_pct"] = float(np.mean(depth > 0.0) * 100.0)
+        energy = passivity_observer(self.force_measured[s], self.qd[s], self.dt)
+        out["max_active_energy_j"] = energy.max_active_j
+        out["bandwidth_hz"] = out["impedance_error_pct"] = out["coherence_in_band"] = None
+        if cfg.wall.stiffness_n_per_m > 0.0:
+            try:
+                tr = transparency(
+                    self.q[s],
+                    self.force_measured[s],
+                    fs,
+                    cfg.wall.stiffness_n_per_m,
+                    cfg.wall.damping_n_s_per_m,
+                )
+            except ValueError:  # too short for the spectral settings, or no motion
+                return out
+            out["bandwidth_hz"] = tr.bandwidth_hz
+            out["impedance_error_pct"] = tr.impedance_error_pct
+            out["coherence_in_band"] = tr.mean_coherence_in_band
+        return out
+
+    def save(self, path: str | Path) -> None:
+        """Write the arrays to an ``.npz`` file."""
+        arrays = {
+            f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "config"
+        }
+        np.savez(path, **arrays)
+
+
+def run_session(config: SessionConfig, cycles: int | None = None) -> SessionResult:
+    """Run ``config`` in-process for ``cycles`` cycles (default: duration_s * rate_hz)."""
+    loop = config.loop
+    device = SimulatedSlide(
+        config.model,
+        config.device,
+        config.sensor,
+        config.hand,
+        loop.rate_hz,
+        loop.substeps,
+        loop.seed,
+    )
+    n = round(loop.duration_s * loop.rate_hz) if cycles is None else int(cycles)
+    if n <= 0:
+        raise ValueError(f"a batch session needs at least one cycle, got {n}")
+    obs_model = (config.observer_model or config.model).model()
+    observer = config.observer.build(obs_model, device.dt)
+    controller = ImpedanceController(obs_model, config.law)
+    wall = config.wall
+    axis = device.model.axis
+    ax0, ax1, ax2 = (float(a) for a in axis)
+
+    rec = np.empty((n, 9))
+    for k in range(n):
+        s = device.sample()
+        x_true = device.x
+        f_wall = wall.force(s.ee_position, s.ee_velocity)
+        observer.update(s.q, s.qd, s.effort)
+        fe = observer.wrench(s.q)
+        f_est = (float(fe[0]), float(fe[1]), float(fe[2]))
+        tau = controller.command(s.q, f_wall, s.wrench_measured, f_est)
+        device.apply(tau)
+        fm, fh = s.wrench_measured, s.hand_force
+        rec[k] = (
+            x_true,
+            s.q[0],
+            s.qd[0],
+            s.effort[0],
+            tau[0],
+            f_wall[0] * ax0 + f_wall[1] * ax1 + f_wall[2] * ax2,
+            fh[0] * ax0 + fh[1] * ax1 + fh[2] * ax2,
+            fm[0] * ax0 + fm[1] * ax1 + fm[2] * ax2,
+            f_est[0] * ax0 + f_est[1] * ax1 + f_est[2] * ax2,
+        )
+    cols = rec.T
+    return SessionResult(
+        config=config,
+        t=np.arange(n) * device.dt,
+        x_true=cols[0].copy(),
+        q=cols[1].copy(),
+        qd=cols[2].copy(),
+        effort=cols[3].copy(),
+        command=cols[4].copy(),
+        wall_force=cols[5].copy(),
+        hand_force=cols[6].copy(),
+        force_measured=cols[7].copy(),
+        force_estimated=cols[8].copy(),
+    )

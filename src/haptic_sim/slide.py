@@ -1,0 +1,213 @@
+"""The simulated 1-DOF slide: plant, encoder, force sensor and hand in one stepping object.
+
+Plant ``(m + m_h) x'' = F_a + F_grip - b x' - Fc sgn(x')``, ``F_grip = k_h (x_r - x) +
+b_h (x_r' - x') + f_ff`` (the hand), with sticking: at rest the Coulomb force holds up to ``Fc``
+and the mass stays stuck while the other forces are smaller; a velocity sign change inside a
+physics step stops the mass (it may break away the next step).
+
+Integration: ``substeps`` physics steps per control period (at least 10 kHz at 1 kHz control),
+each the exact solution of the linear part (mass, viscous friction, grip spring and damper; the
+2x2 matrix exponential computed once) with the actuator force, the hand's reference and the
+Coulomb force held over the step. Exact integration matters: a semi-implicit Euler step moves
+the mass ahead of the held force by ``T / (2 n)`` and raises the open-loop onset by ``n / (n-1)``.
+The actuator force is held over the period (zero-order hold) and saturated at ``max_force_n``.
+The encoder quantizes to ``encoder_resolution_m``; velocity is the backward difference of the
+encoder positions, as a real device's driver computes it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg import expm
+
+from haptic_dob.models.slide import SlideParams
+from haptic_dob.validation import finite_scalar, positive
+from haptic_msgs_py.params import param
+from haptic_sim.device import DeviceSample
+from haptic_sim.hand import HandParams, HandReference
+from haptic_sim.sensor import ForceSensor, ForceSensorParams, quantize
+
+
+@dataclass(frozen=True)
+class SlideDeviceParams:
+    """The simulated slide's actuator, encoder and start (its physics is a ``SlideParams``)."""
+
+    max_force_n: float = field(
+        default=4.0, metadata=param("actuator saturation (continuous force)", "N", 1e-3, 1e3)
+    )
+    encoder_resolution_m: float = field(
+        default=1e-6, metadata=param("encoder resolution", "m", 1e-12, 1e-2)
+    )
+    initial_position_m: float = field(
+        default=0.0, metadata=param("slide position at start", "m", -1.0, 1.0)
+    )
+
+    def __post_init__(self) -> None:
+        positive("max_force_n", self.max_force_n)
+        positive("encoder_resolution_m", self.encoder_resolution_m)
+        finite_scalar("initial_position_m", self.initial_position_m)
+
+
+class SimulatedSlide:
+    """Plant + encoder + force sensor + hand, stepping in the device cycle contract.
+
+    Args:
+        physics: the slide's true mass and friction (``SlideParams``).
+        device: actuator, encoder and start settings.
+        sensor: force-sensor settings.
+        hand: hand settings.
+        rate_hz: control rate (Hz), > 0.
+        substeps: physics steps per control period, >= 1.
+        seed: seed of the hand's reference and the sensor noise.
+    """
+
+    dof = 1
+
+    def __init__(
+        self,
+        physics: SlideParams | None = None,
+        device: SlideDeviceParams | None = None,
+        sensor: ForceSensorParams | None = None,
+        hand: HandParams | None = None,
+        rate_hz: float = 1000.0,
+        substeps: int = 10,
+        seed: int = 0,
+    ) -> None:
+        self.physics = physics or SlideParams()
+        self.device = device or SlideDeviceParams()
+        self.sensor_params = sensor or ForceSensorParams()
+        self.hand = hand or HandParams()
+        self.rate_hz = positive("rate_hz", rate_hz)
+        if int(substeps) != substeps or substeps < 1:
+            raise ValueError(f"substeps must be an integer >= 1, got {substeps!r}")
+        self.substeps = int(substeps)
+        self.period_ns = round(1e9 / self.rate_hz)
+        self.dt = self.period_ns * 1e-9
+        self.dt_physics = self.dt / self.substeps
+        self.model = self.physics.model()
+        self._axis = tuple(float(a) for a in self.model.axis)
+        hand_rng, sensor_rng = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2)
+        )
+        self._reference = HandReference(self.hand, self.dt_physics, hand_rng)
+        self._sensor = ForceSensor(self.sensor_params, self.dt_physics, sensor_rng)
+        self._discretise()
+        # state
+        self._k = 0
+        self.x = self.device.initial_position_m
+        self.v = 0.0
+        self.accel = 0.0
+        self.hand_force_true = 0.0
+        self._q = quantize(self.x, self.device.encoder_resolution_m)
+        self._q_prev = self._q
+        self._effort_applied = 0.0
+        self._i_phys = 0
+        self._sample = self._make_sample()
+
+    @property
+    def k(self) -> int:
+        """Index of the current sample."""
+        return self._k
+
+    def sample(self) -> DeviceSample:
+        """The current sample k."""
+        return self._sample
+
+    def apply(self, effort: list[float] | tuple[float, ...]) -> None:
+        """Hold ``effort`` (N, length 1; saturated at max_force_n) over [k, k+1) and step to k+1.
+
+        Non-finite or wrong-length efforts raise ``ValueError`` and change nothing.
+        """
+        if len(effort) != 1:
+            raise ValueError(f"effort must have length 1, got {len(effort)}")
+        u = float(effort[0])
+        if not math.isfinite(u):
+            raise ValueError(f"effort must be finite, got {u}")
+        lim = self.device.max_force_n
+        u = lim if u > lim else (-lim if u < -lim else u)
+        self._integrate(u)
+        self._effort_applied = u
+        self._k += 1
+        self._q_prev = self._q
+        self._q = quantize(self.x, self.device.encoder_resolution_m)
+        self._sample = self._make_sample()
+
+    # ------------------------------------------------------------------------------------------
+    def _integrate(self, u: float) -> None:
+        h = self.hand
+        fc, b = self.model.coulomb_n, self.model.viscous_n_s_per_m
+        kh, bh, mh = h.stiffness_n_per_m, h.damping_n_s_per_m, h.mass_kg
+        inv_m = self._inv_total_mass
+        p00, p01, p10, p11, g0, g1 = self._step_matrices
+        active = h.active
+        x, v = self.x, self.v
+        a = 0.0
+        grip = 0.0
+        sensor = self._sensor
+        for _ in range(self.substeps):
+            drive = u
+            if active:
+                xr, vr, ff, j = self._reference.arrays(self._i_phys)
+                grip = kh * (xr[j] - x) + bh * (vr[j] - v) + ff[j]
+                drive = u + kh * xr[j] + bh * vr[j] + ff[j]
+            self._i_phys += 1
+            f = u + grip - b * v  # every force but Coulomb, at the start of the step
+            if v > 0.0:
+                friction = fc
+            elif v < 0.0:
+                friction = -fc
+            elif f > fc:
+                friction = fc
+            elif f < -fc:
+                friction = -fc
+            else:  # stuck: static friction balances the rest
+                a = 0.0
+                sensor.track(grip)
+                continue
+            a = (f - friction) * inv_m
+            w = drive - friction
+            x_new = p00 * x + p01 * v + g0 * w
+            v_new = p10 * x + p11 * v + g1 * w
+            if fc > 0.0 and ((v > 0.0 > v_new) or (v < 0.0 < v_new)):
+                v_new = 0.0
+            x, v = x_new, v_new
+            sensor.track(grip - mh * a)
+        self.x, self.v, self.accel = x, v, a
+        self.hand_force_true = grip - mh * a
+
+    def _discretise(self) -> None:
+        """Matrix exponential of the linear part over one physics step (zero-order hold input)."""
+        h = self.hand
+        M = self.model.mass_kg + h.mass_kg
+        kh = h.stiffness_n_per_m if h.active else 0.0
+        bh = h.damping_n_s_per_m if h.active else 0.0
+        A = np.array([[0.0, 1.0], [-kh / M, -(self.model.viscous_n_s_per_m + bh) / M]])
+        B = np.array([[0.0], [1.0 / M]])
+        aug = np.zeros((3, 3))
+        aug[:2, :2], aug[:2, 2:] = A, B
+        E = expm(aug * self.dt_physics)
+        self._step_matrices = tuple(
+            float(E[i, j]) for i, j in ((0, 0), (0, 1), (1, 0), (1, 1), (0, 2), (1, 2))
+        )
+        self._inv_total_mass = 1.0 / M
+
+    def _make_sample(self) -> DeviceSample:
+        q = self._q
+        qd = (q - self._q_prev) / self.dt
+        ax = self._axis
+        fm = self._sensor.read()
+        fh = self.hand_force_true
+        return DeviceSample(
+            k=self._k,
+            stamp_ns=self._k * self.period_ns,
+            q=(q,),
+            qd=(qd,),
+            effort=(self._effort_applied,),
+            ee_position=(ax[0] * q, ax[1] * q, ax[2] * q),
+            ee_velocity=(ax[0] * qd, ax[1] * qd, ax[2] * qd),
+            wrench_measured=(ax[0] * fm, ax[1] * fm, ax[2] * fm),
+            hand_force=(ax[0] * fh, ax[1] * fh, ax[2] * fh),
+        )

@@ -1,0 +1,34 @@
+"""Shared test helpers."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+BIN = Path(sys.executable).parent
+
+
+@pytest.fixture
+def root() -> Path:
+    """The repository root."""
+    return ROOT
+
+
+def tool(name: str) -> str:
+    """Path of a console script installed next to the running interpreter."""
+    path = BIN / name
+    assert path.exists(), f"{name} is not installed in {BIN}"
+    return str(path)
+
+
+@pytest.fixture(autouse=True)
+def _no_ros_domain_leak(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Tests never talk to a lab network: discovery stays on this host."""
+    monkeypatch.setenv(
+        "ROS_AUTOMATIC_DISCOVERY_RANGE",
+        os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST"),
+    )

@@ -1,0 +1,45 @@
+"""The numeric core never imports rclpy: every non-node module loads in a process without it."""
+
+from __future__ import annotations
+
+import pkgutil
+import subprocess
+import sys
+
+import haptic_dob
+import haptic_msgs_py
+import haptic_sim
+
+ROS_PARTS = ("nodes", "ros", "launch")
+
+
+def core_modules() -> list[str]:
+    """Every module of the three packages outside the node/ROS subpackages."""
+    names = []
+    for pkg in (haptic_msgs_py, haptic_dob, haptic_sim):
+        names.append(pkg.__name__)
+        for info in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + "."):
+            parts = info.name.split(".")
+            if any(p in ROS_PARTS or p.endswith("_node") for p in parts[1:]):
+                continue
+            names.append(info.name)
+    return names
+
+
+def test_there_are_core_modules() -> None:
+    mods = core_modules()
+    assert "haptic_dob.observer" in mods and "haptic_sim.session" in mods
+
+
+def test_core_modules_do_not_import_rclpy() -> None:
+    code = (
+        "import importlib, sys\n"
+        f"mods = {core_modules()!r}\n"
+        "for m in mods:\n"
+        "    importlib.import_module(m)\n"
+        "bad = sorted(k for k in sys.modules if k == 'rclpy' or k.startswith('rclpy.'))\n"
+        "print(','.join(bad))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "", f"rclpy imported by the core: {out.stdout.strip()}"

@@ -1,0 +1,71 @@
+"""haptic-stability: onsets against the theory bounds, output and bad input."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import tool
+from haptic_sim.stability import StabilityPoint, onset
+
+
+def stability(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [tool("haptic-stability"), *args], capture_output=True, text=True, timeout=300
+    )
+
+
+def test_onset_interpolates_the_first_zero_crossing() -> None:
+    pts = [StabilityPoint(k, g, 10.0, 1e-4) for k, g in [(100, -1.0), (200, -0.5), (300, 0.5)]]
+    assert onset(pts) == pytest.approx(250.0)
+    assert onset(pts[:2]) is None
+    assert onset(pts[2:]) == 300.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("controller", "kf", "bound"),
+    [("OL", "0", 2544.0), ("CL", "2", 848.0)],
+)
+def test_onset_is_within_five_percent_of_the_passivity_bound(
+    controller: str, kf: str, bound: float
+) -> None:
+    out = stability("--controller", controller, "--kf", kf, "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert {"controller", "kf", "onset_stiffness_n_per_m", "theory_bound_n_per_m"} <= set(data)
+    assert data["controller"] == controller
+    assert data["theory_bound_n_per_m"] == pytest.approx(bound)
+    assert data["onset_stiffness_n_per_m"] == pytest.approx(bound, rel=0.05)
+    vib = np.array([p["vibrates"] for p in data["points"]])
+    ks = np.array([p["stiffness_n_per_m"] for p in data["points"]])
+    # decays well below the bound, vibrates everywhere above it
+    assert not vib[ks < 0.8 * bound].any() and vib[ks > 1.2 * bound].all()
+
+
+def test_table_output() -> None:
+    out = stability("--stiffness", "2000:3000:500")
+    assert out.returncode == 0, out.stderr
+    assert "onset: 2" in out.stdout and "theory bound" in out.stdout
+    assert len(out.stdout.splitlines()) == 6
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--stiffness", "1:x:3"], "ERROR: --stiffness must be FROM:TO:STEP"),
+        (["--stiffness", "300:100:10"], "ERROR: --stiffness needs 0 < FROM <= TO"),
+        (["--kf", "-1"], "ERROR: --kf must be >= 0"),
+        (["--observer-gain", "0"], "ERROR: --observer-gain must be > 0"),
+        (["--controller", "PID"], "ERROR: argument --controller"),
+        (["--config", "no-such-config.yaml"], "ERROR: no config"),
+    ],
+)
+def test_bad_input_gets_one_error_line_and_exit_2(args: list[str], message: str) -> None:
+    out = stability(*args)
+    assert out.returncode == 2
+    assert message in out.stderr
+    assert "Traceback" not in out.stderr
