@@ -230,3 +230,22 @@ def test_update_rejects_bad_samples(args, name: str) -> None:
     generic = DisturbanceObserver(ConstantInertia(np.eye(1) * 0.4), 10.0, 1e-3)
     with pytest.raises(ValueError, match=rf"^{name} "):
         generic.update(*args)
+
+
+@pytest.mark.parametrize("generic", [False, True])
+def test_retune_keeps_the_estimate_and_takes_the_new_gain(generic: bool) -> None:
+    """At constant velocity ``d_hat' = alpha d_hat + (1 - alpha)(h - tau)``: after a retune the
+    next sample continues from the old estimate with the new gain's alpha."""
+    model = ConstantInertia(np.array([[0.416]])) if generic else SlideModel(coulomb_n=0.0)
+    obs = DisturbanceObserver(model, 10.0, 1e-3)
+    obs.update([0.0], [0.2], [0.0])
+    for _ in range(50):
+        before = obs.update([0.0], [0.2], [-1.0])[0]
+    obs.retune(40.0, limit=3.0)
+    assert obs.gain == 40.0 and obs.limit.tolist() == [3.0]
+    after = obs.update([0.0], [0.2], [-1.0])[0]
+    h = 0.0 if generic else 1.272 * 0.2
+    alpha = 0.416 / (0.416 + 1e-3 * 40.0) if generic else math.exp(-40.0 * 1e-3 / 0.416)
+    assert after == pytest.approx(alpha * before + (1 - alpha) * (h + 1.0), rel=1e-12)
+    with pytest.raises(ValueError, match="gain"):
+        obs.retune(0.0)

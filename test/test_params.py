@@ -17,6 +17,7 @@ def test_specs_carry_description_unit_range_and_choices() -> None:
     assert "[N]" in specs["max_force_n"].full_description()
     wall = {s.name: s for s in specs_of(VirtualWall, "wall.")}
     assert wall["wall.normal"].default == [1.0, 0.0, 0.0] and wall["wall.normal"].kind is list
+    assert wall["wall.normal"].length == 3
     assert specs_of(HandParams, read_only=True)[0].read_only
 
 
@@ -30,8 +31,9 @@ def test_specs_carry_description_unit_range_and_choices() -> None:
         (ParamSpec("kf", 0.0, "gain"), True, "kf must be a number"),
         (ParamSpec("n", 1, "count"), 1.5, "n must be an integer"),
         (ParamSpec("m", "OL", "mode", choices=("OL", "CL")), "X", "m must be one of OL, CL"),
-        (ParamSpec("v", [0.0, 0.0], "vec"), [1.0], "v must have 2 elements"),
+        (ParamSpec("v", [0.0, 0.0], "vec", length=2), [1.0], "v must have 2 elements"),
         (ParamSpec("v", [0.0, 0.0], "vec"), [1.0, float("inf")], "finite numbers"),
+        (ParamSpec("s", ["a"], "names"), ["a", 1], "s must be an array of strings"),
         (ParamSpec("b", False, "flag"), 1, "b must be a bool"),
     ],
 )
@@ -42,6 +44,7 @@ def test_refused_values_come_with_a_reason(spec: ParamSpec, value, reason: str) 
 def test_accepted_values_have_no_reason() -> None:
     assert ParamSpec("kf", 0.0, "gain", min=0.0).check(3) is None
     assert ParamSpec("v", [0.0, 0.0], "vec").check([1, 2.5]) is None
+    assert ParamSpec("s", ["a"], "names").check(["a", "b", "c"]) is None
 
 
 def test_build_and_values_round_trip() -> None:

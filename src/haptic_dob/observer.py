@@ -92,25 +92,47 @@ class DisturbanceObserver:
         self.gain = positive("gain", gain)
         self.dt = positive("dt", dt)
         n = model.dof
-        if limit is None:
-            self.limit: Vec | None = None
-        else:
-            lim = np.asarray(limit, dtype=np.float64)
-            lim = np.full(n, float(lim)) if lim.ndim == 0 else vector("limit", lim, n)
-            for i, v in enumerate(lim):
-                positive(f"limit[{i}]", v)
-            self.limit = lim
+        self.limit = self._check_limit(limit)
         self.dls_threshold_m = positive("dls_threshold_m", dls_threshold_m)
         self.dls_damping_m = positive("dls_damping_m", dls_damping_m)
         self._scalar = isinstance(model, SlideModel)
         self._eye = np.eye(n)
+        self._set_gain(self.gain)
+        self.reset()
+
+    def _check_limit(self, limit: float | ArrayLike | None) -> Vec | None:
+        if limit is None:
+            return None
+        n = self.model.dof
+        lim = np.asarray(limit, dtype=np.float64)
+        lim = np.full(n, float(lim)) if lim.ndim == 0 else vector("limit", lim, n)
+        for i, v in enumerate(lim):
+            positive(f"limit[{i}]", v)
+        return lim
+
+    def _set_gain(self, gain: float) -> None:
+        self.gain = positive("gain", gain)
         if self._scalar:
-            m = model.mass_kg  # type: ignore[attr-defined]
+            m = self.model.mass_kg  # type: ignore[attr-defined]
             self._alpha = math.exp(-self.gain * self.dt / m)
             self.discrete_gain = m * math.expm1(self.gain * self.dt / m) / self.dt
         else:
             self.discrete_gain = self.gain
-        self.reset()
+
+    def retune(self, gain: float, limit: float | ArrayLike | None = None) -> None:
+        """Change gain and output clip while running, keeping the current estimate (no jump).
+
+        ``d_hat = z + c q'``: the state is shifted by ``(c_old - c_new) q'`` of the last sample.
+        """
+        new_limit = self._check_limit(limit)
+        old = self.discrete_gain
+        self._set_gain(gain)
+        self.limit = new_limit
+        if self._initialised:
+            if self._scalar:
+                self._z_s += (old - self.discrete_gain) * self._v_last
+            else:
+                self._z = self._z + (old - self.discrete_gain) * self._qd_last
 
     # ------------------------------------------------------------------------------------------
     def reset(self) -> None:
@@ -122,6 +144,8 @@ class DisturbanceObserver:
         self._h_prev: Vec = np.zeros(n)
         self._z_s = 0.0
         self._h_s = 0.0
+        self._v_last = 0.0
+        self._qd_last: Vec = np.zeros(n)
         self._estimate = np.zeros(n)
 
     @property
@@ -156,6 +180,7 @@ class DisturbanceObserver:
             d = np.zeros(model.dof)
             self._initialised = True
         self._D_prev, self._h_prev = D, h
+        self._qd_last = qd_
         if self.limit is not None:
             d = np.clip(d, -self.limit, self.limit)
         self._estimate = d
@@ -180,6 +205,7 @@ class DisturbanceObserver:
             d = 0.0
             self._initialised = True
         self._h_s = model.friction_scalar(v)
+        self._v_last = v
         if self.limit is not None:
             lim = self.limit[0]
             d = lim if d > lim else (-lim if d < -lim else d)

@@ -31,6 +31,7 @@ class ParamSpec:
     max: float | None = None
     choices: tuple[str, ...] = ()
     read_only: bool = False
+    length: int | None = None  # arrays: the required number of elements, None = any
 
     @property
     def kind(self) -> type:
@@ -75,8 +76,8 @@ class ParamSpec:
             return f"{self.name} must be an array, got {value!r}"
         items = list(value)
         default = list(self.default)  # type: ignore[arg-type]
-        if default and len(items) != len(default):
-            return f"{self.name} must have {len(default)} elements, got {len(items)}"
+        if self.length is not None and len(items) != self.length:
+            return f"{self.name} must have {self.length} elements, got {len(items)}"
         if default and isinstance(default[0], str):
             if not all(isinstance(v, str) for v in items):
                 return f"{self.name} must be an array of strings"
@@ -128,8 +129,9 @@ def specs_of(cls: type, prefix: str = "", read_only: bool | None = None) -> list
             continue
         missing = f.default is dataclasses.MISSING
         default = f.default_factory() if missing else f.default  # type: ignore[misc]
+        length = None
         if isinstance(default, tuple):
-            default = list(default)
+            default, length = list(default), len(default)
         elif isinstance(default, Enum):
             default = default.value
         out.append(
@@ -142,6 +144,7 @@ def specs_of(cls: type, prefix: str = "", read_only: bool | None = None) -> list
                 max=meta["max"],
                 choices=meta["choices"],
                 read_only=meta["read_only"] if read_only is None else read_only,
+                length=length,
             )
         )
     return out

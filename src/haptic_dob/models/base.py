@@ -29,6 +29,8 @@ class DeviceModel(ABC):
     dof: int
     #: joint names in the order of every joint-space vector
     joint_names: tuple[str, ...]
+    #: True when J does not depend on q (a controller then needs no joint positions)
+    constant_jacobian: bool = False
 
     # --- public, validated -------------------------------------------------------------------
     def mass_matrix(self, q: ArrayLike) -> Mat:

@@ -1,0 +1,311 @@
+"""``haptic-launch``: bring up a session's node graph from one ``ros__parameters`` YAML.
+
+Every node section of the YAML (``device_node``, ``environment_node``, ``observer_node``,
+``controller_node``, ``recorder_node``) starts as its own process through the ``ros2 run``
+contract (``<prefix>/lib/<pkg>/<exe>`` found with ``ament_index_python``), with
+``--ros-args --params-file CONFIG`` and the namespace. The device starts last. Ctrl-C or SIGTERM
+is forwarded to every node as SIGINT (each shuts down cleanly: the device zeroes its effort) and
+the launcher waits for them, killing what is still alive after ``--stop-timeout``. When the
+device finishes a lockstep run (``duration_s``) the others are stopped too. ``--composed`` runs
+all nodes in this one process under one executor instead.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from haptic_dob.cli import ArgumentParser, CliError, run
+from haptic_dob.configs import resolve_config
+
+#: node name -> (package, executable, import path of the node class for --composed)
+NODES: dict[str, tuple[str, str, str]] = {
+    "environment_node": (
+        "haptic_dob",
+        "environment_node",
+        "haptic_dob.nodes.environment_node:EnvironmentNode",
+    ),
+    "observer_node": ("haptic_dob", "observer_node", "haptic_dob.nodes.observer_node:ObserverNode"),
+    "controller_node": (
+        "haptic_dob",
+        "controller_node",
+        "haptic_dob.nodes.controller_node:ControllerNode",
+    ),
+    "recorder_node": ("haptic_dob", "recorder_node", "haptic_dob.nodes.recorder_node:RecorderNode"),
+    "device_node": ("haptic_sim", "device_node", "haptic_sim.nodes.device_node:DeviceNode"),
+}
+START_ORDER = (
+    "recorder_node",
+    "environment_node",
+    "observer_node",
+    "controller_node",
+    "device_node",
+)
+
+
+@dataclass
+class NodeSpec:
+    """One node to start: name, executable and its ROS arguments."""
+
+    name: str
+    executable: str
+    ros_args: list[str]
+
+
+def executable(package: str, name: str) -> str:
+    """``<prefix>/lib/<package>/<name>`` from the ament index: what ``ros2 run`` executes."""
+    from ament_index_python.packages import PackageNotFoundError, get_package_prefix
+
+    from haptic_msgs_py.ament import ensure_ament_prefix
+
+    ensure_ament_prefix()
+    try:
+        path = Path(get_package_prefix(package)) / "lib" / package / name
+    except PackageNotFoundError:
+        raise CliError(f"package {package} is not in the ament index; reinstall") from None
+    if not os.access(path, os.X_OK):
+        raise CliError(f"{path} is missing or not executable; reinstall")
+    return str(path)
+
+
+def parse_sets(items: Sequence[str]) -> dict[str, dict[str, Any]]:
+    """``NODE:PARAM=VALUE`` (VALUE in YAML syntax) -> {node: {param: value}}."""
+    out: dict[str, dict[str, Any]] = {}
+    for item in items:
+        node, sep, assignment = item.partition(":")
+        param, eq, text = assignment.partition("=")
+        if not (sep and eq and node and param):
+            raise CliError(f"--set needs NODE:PARAM=VALUE, got {item!r}")
+        if node not in NODES:
+            raise CliError(f"--set names unknown node {node!r}; nodes: {', '.join(NODES)}")
+        try:
+            value = yaml.safe_load(text)
+        except yaml.YAMLError:
+            raise CliError(f"--set {item!r}: the value is not valid YAML") from None
+        out.setdefault(node, {})[param] = value
+    return out
+
+
+def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """The config's node sections (flattened, ``--set`` applied), keyed by node name."""
+    try:
+        doc = yaml.safe_load(config.read_text(encoding="utf-8")) or {}
+    except yaml.YAMLError as exc:
+        raise CliError(f"{config} is not valid YAML: {' '.join(str(exc).split())}") from None
+    if not isinstance(doc, dict):
+        raise CliError(f"{config} must map node names to ros__parameters")
+    out: dict[str, Any] = {}
+    for key, body in doc.items():
+        name = "/**" if key == "/**" else str(key).rsplit("/", 1)[-1]
+        params = (body or {}).get("ros__parameters") if isinstance(body, dict) else None
+        if not isinstance(params, dict):
+            raise CliError(f"{config}: section {key!r} has no ros__parameters mapping")
+        out[name] = _flatten(params)
+    unknown = [n for n in out if n != "/**" and n not in NODES]
+    if unknown:
+        raise CliError(
+            f"{config} names unknown node(s) {', '.join(unknown)}; known: {', '.join(NODES)}"
+        )
+    for node, values in sets.items():
+        out.setdefault(node, {}).update(values)
+    return out
+
+
+def _flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        if isinstance(v, dict):
+            out.update(_flatten(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+def write_params_file(params: dict[str, Any], directory: Path) -> Path:
+    """A ``ros__parameters`` file any namespace matches (``/**/<node>`` keys), for this launch."""
+    doc = {}
+    for name, values in params.items():
+        key = "/**" if name == "/**" else f"/**/{name}"
+        doc[key] = {"ros__parameters": values}
+    path = directory / "params.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def plan(params: dict[str, Any], params_file: Path, namespace: str) -> list[NodeSpec]:
+    """The nodes the parameters ask for, in start order, with their ROS arguments."""
+    out = []
+    for name in START_ORDER:
+        if name not in params:
+            continue
+        pkg, exe, _ = NODES[name]
+        args = ["--ros-args", "--params-file", str(params_file), "-r", f"__node:={name}"]
+        if namespace:
+            args += ["-r", f"__ns:={namespace}"]
+        out.append(NodeSpec(name, executable(pkg, exe), args))
+    if not out:
+        raise CliError("the config starts no nodes")
+    return out
+
+
+def launch(specs: list[NodeSpec], stop_timeout: float, duration: float | None) -> int:
+    """Start the processes, supervise them, forward signals, stop them all cleanly."""
+    stop: list[int] = []
+
+    def on_signal(signum: int, _frame: object) -> None:
+        stop.append(signum)
+
+    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    procs: dict[str, subprocess.Popen] = {}
+    code = 0
+    try:
+        for spec in specs:
+            procs[spec.name] = subprocess.Popen(
+                [spec.executable, *spec.ros_args], start_new_session=True
+            )
+        t_end = None if duration is None else time.monotonic() + duration
+        while not stop:
+            done = {n: p.returncode for n, p in procs.items() if p.poll() is not None}
+            if done:
+                name, rc = next(iter(done.items()))
+                if name == "device_node" and rc == 0:
+                    print(
+                        "haptic-launch: device_node finished its run; stopping the graph",
+                        file=sys.stderr,
+                    )
+                else:
+                    print(
+                        f"ERROR: {name} exited with code {rc}; stopping the graph", file=sys.stderr
+                    )
+                    code = 1
+                break
+            if t_end is not None and time.monotonic() >= t_end:
+                break
+            time.sleep(0.05)
+    finally:
+        _stop_all(procs, stop_timeout)
+        for s, h in old.items():
+            signal.signal(s, h)
+    return code
+
+
+def _stop_all(procs: dict[str, subprocess.Popen], timeout: float) -> None:
+    """SIGINT to every live node (device first), wait, then SIGKILL what is left."""
+    order = sorted(procs, key=lambda n: n != "device_node")
+    for name in order:
+        p = procs[name]
+        if p.poll() is None:
+            p.send_signal(signal.SIGINT)
+    deadline = time.monotonic() + timeout
+    for name in order:
+        p = procs[name]
+        try:
+            p.wait(max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            print(
+                f"haptic-launch: {name} did not stop within {timeout:g} s; killing it",
+                file=sys.stderr,
+            )
+            p.kill()
+            p.wait()
+
+
+def compose(specs: list[NodeSpec], executor: str | None) -> int:
+    """All nodes in this process under one executor (same parameters file and namespace)."""
+    import importlib
+
+    from haptic_msgs_py.ros.spin import run_nodes
+
+    classes = []
+    for spec in specs:
+        module, _, cls = NODES[spec.name][2].partition(":")
+        classes.append((spec.name, getattr(importlib.import_module(module), cls)))
+    ros_args = specs[0].ros_args
+    cleaned = ["haptic-launch"]
+    i = 0
+    while i < len(ros_args):  # drop the per-process node-name remap
+        if ros_args[i] == "-r" and ros_args[i + 1].startswith("__node:="):
+            i += 2
+            continue
+        cleaned.append(ros_args[i])
+        i += 1
+    return run_nodes(
+        lambda ctx: [cls(context=ctx, name=name) for name, cls in classes], cleaned, executor
+    )
+
+
+def command(
+    config: str,
+    namespace: str,
+    composed: bool,
+    sets: Sequence[str],
+    stop_timeout: float,
+    duration: float | None,
+    executor: str | None,
+) -> int:
+    """Resolve, plan and run; raises ``CliError`` on bad input."""
+    import tempfile
+
+    path = resolve_config(config)
+    params = resolved_params(path, parse_sets(sets))
+    with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
+        specs = plan(params, write_params_file(params, Path(tmp)), namespace)
+        if composed:
+            return compose(specs, executor)
+        if executor:
+            os.environ["HAPTIC_DOB_EXECUTOR"] = executor
+        return launch(specs, stop_timeout, duration)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``haptic-launch``."""
+    p = ArgumentParser(prog="haptic-launch", description=__doc__.split("\n\n")[0])
+    p.add_argument("config", help="session YAML (a path, or an installed name like slide_sim)")
+    p.add_argument("--namespace", default="", help="namespace of every node (one device per ns)")
+    p.add_argument(
+        "--composed", action="store_true", help="run all nodes in this process under one executor"
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NODE:PARAM=VALUE",
+        help="override a parameter of one node (repeatable)",
+    )
+    p.add_argument(
+        "--duration",
+        type=float,
+        metavar="S",
+        help="stop the graph after this many wall-clock seconds",
+    )
+    p.add_argument(
+        "--stop-timeout",
+        type=float,
+        default=5.0,
+        metavar="S",
+        help="how long nodes get to stop cleanly before they are killed (default 5)",
+    )
+    p.add_argument(
+        "--executor",
+        choices=["events", "single"],
+        help="rclpy executor of the nodes (default events)",
+    )
+    a = p.parse_args(argv)
+    return run(
+        lambda: command(
+            a.config, a.namespace, a.composed, a.set, a.stop_timeout, a.duration, a.executor
+        )
+    )
+
+
+if __name__ == "__main__":
+    sys.exit(main())

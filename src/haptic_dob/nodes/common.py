@@ -1,0 +1,28 @@
+"""Parameters and helpers every loop node shares (rate, frames, loop mode)."""
+
+from __future__ import annotations
+
+from haptic_msgs_py.params import ParamSpec
+from haptic_msgs_py.topics import DEFAULT_BASE_FRAME, DEFAULT_EE_FRAME
+
+CLOCK_MODES = ("lockstep", "realtime")
+
+
+def loop_specs() -> list[ParamSpec]:
+    """``rate_hz`` and the frames: the same on every node of a session (YAML ``/**``)."""
+    return [
+        ParamSpec("rate_hz", 1000.0, "control rate of the loop", "Hz", 1.0, 1e5, read_only=True),
+        ParamSpec(
+            "base_frame", DEFAULT_BASE_FRAME, "frame of poses, twists and wrenches", read_only=True
+        ),
+        ParamSpec("ee_frame", DEFAULT_EE_FRAME, "frame name of the end effector", read_only=True),
+    ]
+
+
+def main_for(node_class: type, args: list[str] | None = None) -> int:
+    """``main()`` of a single-node executable: spin it until Ctrl-C/SIGTERM."""
+    from haptic_msgs_py.ament import ensure_ament_prefix
+    from haptic_msgs_py.ros.spin import run_nodes
+
+    ensure_ament_prefix()
+    return run_nodes(lambda ctx: [node_class(context=ctx)], args)

@@ -1,0 +1,235 @@
+"""controller_node: the OL / CL / DOB impedance law. Stamp-k inputs -> effort_command k.
+
+Inputs: ``wrench_desired`` (the wall), ``joint_states`` (for J(q); not subscribed when the model's
+Jacobian is constant, as on the slide), and, as the mode needs them, ``wrench_measured`` (CL) or
+``wrench_estimate`` (DOB). Command k goes out as soon as every input
+of stamp k the mode needs has arrived, labelled with its stamp (``effort@<ns>``). ``mode``, ``kf``
+and ``max_force_n`` change at run time: the next command uses the new law, with no other state to
+carry (bumpless). A switch to CL or DOB is refused while its force input is not flowing (the
+observer must be warm before DOB takes over).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections import deque
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from rclpy.context import Context
+
+from haptic_dob.control import ZERO_FORCE, ControlMode, ImpedanceController, ImpedanceLaw
+from haptic_dob.models.factory import build_model, model_specs
+from haptic_dob.nodes.common import loop_specs, main_for
+from haptic_dob.nodes.observer_node import JointMap, pick
+from haptic_msgs_py import wire
+from haptic_msgs_py.convert import read_force
+from haptic_msgs_py.params import ParamSpec, build, specs_of
+from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.params import ParameterTable
+from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
+from haptic_msgs_py.ros.spin import LoopNode
+from haptic_msgs_py.stamps import command_label, to_ns
+from haptic_msgs_py.topics import (
+    EFFORT_COMMAND,
+    JOINT_STATES,
+    SESSION_TOPICS,
+    WRENCH_DESIRED,
+    WRENCH_ESTIMATE,
+    WRENCH_MEASURED,
+)
+
+#: a force input counts as flowing when this many of its samples came within the last
+#: WARM_WINDOW cycles (a few may be late or lost: loop inputs are best effort)
+WARM_SAMPLES = 20
+WARM_WINDOW = 100
+INPUT_TOPIC = {"measured": WRENCH_MEASURED, "estimated": WRENCH_ESTIMATE}
+
+
+class _Input:
+    """The newest message of one input (stamp in ns, value) and the stamps of the last few."""
+
+    __slots__ = ("recent", "stamp", "value")
+
+    def __init__(self) -> None:
+        self.stamp = -1
+        self.value: Any = ZERO_FORCE
+        self.recent: deque[int] = deque(maxlen=WARM_SAMPLES)
+
+    def take(self, stamp: int, value: Any) -> None:
+        self.stamp = stamp
+        self.value = value
+        self.recent.append(stamp)
+
+    def flowing(self, newest: int, period_ns: int) -> bool:
+        """WARM_SAMPLES samples arrived within the WARM_WINDOW cycles up to ``newest``."""
+        r = self.recent
+        return len(r) == WARM_SAMPLES and r[0] >= newest - WARM_WINDOW * period_ns
+
+
+class ControllerNode(LoopNode):
+    """Computes command k from the stamp-k inputs its mode needs."""
+
+    def __init__(self, context: Context | None = None, name: str = "controller_node") -> None:
+        super().__init__(name, context=context)
+        specs = [
+            *loop_specs(),
+            *model_specs(),
+            *specs_of(ImpedanceLaw),
+            ParamSpec(
+                "input_warn_s",
+                2.0,
+                "warn when an input of a pending cycle is this late",
+                "s",
+                0.01,
+                3600.0,
+            ),
+        ]
+        self.params = ParameterTable(self, specs, self._settings, self._apply)
+        values = self.params.values
+        self.model = build_model(values)
+        self.period_ns = round(1e9 / values["rate_hz"])
+        self.controller = ImpedanceController(self.model, self.params.settings)
+        self.joints = JointMap(self.model.joint_names)
+        self.js = _Input()
+        self.desired = _Input()
+        self.measured = _Input()
+        self.estimated = _Input()
+        self._q: list[float] = [0.0] * self.model.dof
+        self._sent_ns = -1
+        self._newest_ns = -1
+        self._needs_q = not self.model.constant_jacobian
+        self._pending_since = 0.0
+        self._warned_ns = -1
+        self._cmd = wire.float64_multi_array("", [0.0] * self.model.dof)
+        self._dim = self._cmd.layout.dim[0]
+        self._pub = RawPublisher(self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, qos.LOOP)
+        inputs = [
+            (WRENCH_DESIRED, self._on_desired),
+            (WRENCH_MEASURED, self._on_measured),
+            (WRENCH_ESTIMATE, self._on_estimated),
+        ]
+        if self._needs_q:
+            inputs.append((JOINT_STATES, self._on_joint_states))
+        for topic, callback in inputs:
+            raw_subscription(self, SESSION_TOPICS[topic], topic, callback, qos.LOOP_IN)
+
+    # --- parameters ------------------------------------------------------------------------
+    def _settings(self, values: Mapping[str, Any]) -> ImpedanceLaw:
+        law = build(ImpedanceLaw, values)
+        if hasattr(self, "controller"):  # a change at run time, not the start-up values
+            need = law.needs
+            old = self.controller.law.needs
+            if need is not None and need != old:
+                source = self.measured if need == "measured" else self.estimated
+                if not source.flowing(self._newest_ns, self.period_ns):
+                    raise ValueError(
+                        f"mode {law.mode.value} needs {INPUT_TOPIC[need]}, which is not flowing "
+                        f"(fewer than {WARM_SAMPLES} samples in the last {WARM_WINDOW} cycles)"
+                    )
+        return law
+
+    def _apply(self, law: ImpedanceLaw) -> None:
+        self.controller.law = law
+        self.get_logger().info(
+            f"law now {law.mode.value}, Kf {law.kf:g}, max {law.max_force_n:g} N, from the cycle "
+            f"after stamp_ns {self._sent_ns}"
+        )
+
+    # --- inputs ----------------------------------------------------------------------------
+    def _on_joint_states(self, msg: Any) -> None:
+        st = msg.header.stamp
+        try:
+            idx = self.joints.index(msg.name, len(msg.position))
+            self._q = pick(msg.position, idx, "position", len(msg.name) or len(msg.position))
+        except ValueError as exc:
+            self.get_logger().error(f"ignoring joint_states: {exc}", throttle_duration_sec=5.0)
+            return
+        stamp = to_ns(st.sec, st.nanosec)
+        self._note(stamp)
+        self.js.take(stamp, self._q)
+        self._emit()
+
+    def _on_desired(self, msg: Any) -> None:
+        st = msg.header.stamp
+        stamp = to_ns(st.sec, st.nanosec)
+        self._note(stamp)
+        self.desired.take(stamp, read_force(msg))
+        self._emit()
+
+    def _note(self, stamp: int) -> None:
+        """A cycle-defining input with a newer stamp opens a new pending cycle."""
+        if stamp > self._newest_ns:
+            self._newest_ns = stamp
+            self._pending_since = time.monotonic()
+
+    def _on_measured(self, msg: Any) -> None:
+        st = msg.header.stamp
+        self.measured.take(to_ns(st.sec, st.nanosec), read_force(msg))
+        if self.controller.law.mode is ControlMode.CL:
+            self._emit()
+
+    def _on_estimated(self, msg: Any) -> None:
+        st = msg.header.stamp
+        self.estimated.take(to_ns(st.sec, st.nanosec), read_force(msg))
+        if self.controller.law.mode is ControlMode.DOB:
+            self._emit()
+
+    # --- the law ---------------------------------------------------------------------------
+    def _emit(self) -> None:
+        k = self._newest_ns
+        if k < self._sent_ns or self.desired.stamp != k:
+            return
+        if self._needs_q and self.js.stamp != k:
+            return
+        mode = self.controller.law.mode
+        if (mode is ControlMode.CL and self.measured.stamp != k) or (
+            mode is ControlMode.DOB and self.estimated.stamp != k
+        ):
+            return
+        if k != self._sent_ns:
+            tau = self.controller.command(
+                self.js.value, self.desired.value, self.measured.value, self.estimated.value
+            )
+            self._cmd.data = np.array(tau)
+            self._dim.label = command_label(k)
+            self._sent_ns = k
+        self._pub.publish(self._cmd)  # a repeated sample gets the same command again
+
+    def next_wakeup(self) -> float | None:
+        """While a cycle is pending, look again at the time its inputs are overdue."""
+        if self._newest_ns > self._sent_ns and self._newest_ns != self._warned_ns:
+            return self._pending_since + self.params.values["input_warn_s"]
+        return None
+
+    def on_wakeup(self, now: float) -> None:
+        """Name the inputs a pending cycle still lacks (once per cycle)."""
+        self._warned_ns = self._newest_ns
+        self.get_logger().warning(
+            f"cycle at stamp {self._newest_ns * 1e-9:.3f} s still lacks "
+            f"{', '.join(self.missing_inputs())} after {now - self._pending_since:.1f} s"
+        )
+
+    def missing_inputs(self) -> list[str]:
+        """The inputs of the newest pending cycle the current mode still waits for."""
+        k = self._newest_ns
+        out = [] if self.desired.stamp == k else [WRENCH_DESIRED]
+        if self._needs_q and self.js.stamp != k:
+            out.append(JOINT_STATES)
+        need = self.controller.law.needs
+        if need == "measured" and self.measured.stamp != k:
+            out.append(WRENCH_MEASURED)
+        if need == "estimated" and self.estimated.stamp != k:
+            out.append(WRENCH_ESTIMATE)
+        return out
+
+
+def main(args: list[str] | None = None) -> int:
+    """``ros2 run haptic_dob controller_node``."""
+    return main_for(ControllerNode, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,75 @@
+"""environment_node: the virtual wall. ee_pose + ee_twist of sample k -> wrench_desired k."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Mapping
+from typing import Any
+
+from rclpy.context import Context
+
+from haptic_dob.environment import VirtualWall
+from haptic_dob.nodes.common import loop_specs, main_for
+from haptic_msgs_py import wire
+from haptic_msgs_py.convert import read_linear, read_position, write_force
+from haptic_msgs_py.params import build, specs_of
+from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.params import ParameterTable
+from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
+from haptic_msgs_py.ros.spin import LoopNode
+from haptic_msgs_py.topics import EE_POSE, EE_TWIST, SESSION_TOPICS, WRENCH_DESIRED
+
+
+class EnvironmentNode(LoopNode):
+    """Renders a unilateral wall; its stiffness, damping, position and normal change at run time."""
+
+    def __init__(self, context: Context | None = None, name: str = "environment_node") -> None:
+        super().__init__(name, context=context)
+        self.params = ParameterTable(
+            self, [*loop_specs(), *specs_of(VirtualWall)], self._settings, self._apply
+        )
+        self.wall: VirtualWall = self.params.settings
+        self._pose: Any = None
+        self._twist: Any = None
+        self._out = wire.wrench_stamped(self.params.values["base_frame"])
+        self._pub = RawPublisher(self, SESSION_TOPICS[WRENCH_DESIRED], WRENCH_DESIRED, qos.LOOP)
+        raw_subscription(self, SESSION_TOPICS[EE_POSE], EE_POSE, self._on_pose, qos.LOOP_IN)
+        raw_subscription(self, SESSION_TOPICS[EE_TWIST], EE_TWIST, self._on_twist, qos.LOOP_IN)
+
+    @staticmethod
+    def _settings(values: Mapping[str, Any]) -> VirtualWall:
+        return build(VirtualWall, values)
+
+    def _apply(self, wall: VirtualWall) -> None:
+        self.wall = wall
+        self.get_logger().info(f"wall now {wall}")
+
+    def _on_pose(self, msg: Any) -> None:
+        self._pose = msg
+        self._emit()
+
+    def _on_twist(self, msg: Any) -> None:
+        self._twist = msg
+        self._emit()
+
+    def _emit(self) -> None:
+        pose, twist = self._pose, self._twist
+        if pose is None or twist is None:
+            return
+        a, b = pose.header.stamp, twist.header.stamp
+        if a.sec != b.sec or a.nanosec != b.nanosec:
+            return
+        force = self.wall.force(read_position(pose), read_linear(twist))
+        out = self._out
+        out.header.stamp = a
+        write_force(out, force)
+        self._pub.publish(out)
+
+
+def main(args: list[str] | None = None) -> int:
+    """``ros2 run haptic_dob environment_node``."""
+    return main_for(EnvironmentNode, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

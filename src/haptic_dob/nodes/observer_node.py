@@ -1,0 +1,182 @@
+"""observer_node: joint_states of sample k -> wrench_estimate k and effort_estimate k.
+
+Runs the core ``DisturbanceObserver`` on the device model. Joints are matched by name (any order,
+extra joints ignored); a sample without velocities is differentiated from positions. A sample
+whose stamp was already handled is answered again with the same estimate (idempotent, so a
+re-published sample in lockstep is safe); an older one is ignored. ``~/reset`` re-zeroes.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from rclpy.context import Context
+from std_srvs.srv import Trigger
+
+from haptic_dob.models.base import DeviceModel
+from haptic_dob.models.factory import build_model, model_specs
+from haptic_dob.nodes.common import loop_specs, main_for
+from haptic_dob.observer import DisturbanceObserver, ObserverSettings
+from haptic_msgs_py import wire
+from haptic_msgs_py.convert import write_force
+from haptic_msgs_py.params import build, specs_of
+from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.params import ParameterTable
+from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
+from haptic_msgs_py.ros.spin import LoopNode
+from haptic_msgs_py.stamps import to_ns
+from haptic_msgs_py.topics import EFFORT_ESTIMATE, JOINT_STATES, SESSION_TOPICS, WRENCH_ESTIMATE
+
+
+class JointMap:
+    """Pick a model's joints out of a JointState by name (any order, extra joints ignored)."""
+
+    def __init__(self, joint_names: Sequence[str]) -> None:
+        self.joint_names = tuple(joint_names)
+        self._names: list[str] | None = None
+        self._index: list[int] | None = None
+
+    def index(self, names: Sequence[str], n_values: int) -> list[int]:
+        """Positions of the model's joints in a message with ``names`` (ValueError if missing)."""
+        if not names:
+            if n_values != len(self.joint_names):
+                raise ValueError(
+                    f"joint_states without names must have {len(self.joint_names)} values in "
+                    f"model order, got {n_values}"
+                )
+            return list(range(n_values))
+        if self._names is not None and list(names) == self._names:
+            return self._index  # type: ignore[return-value]
+        where = {n: i for i, n in enumerate(names)}
+        missing = [j for j in self.joint_names if j not in where]
+        if missing:
+            raise ValueError(
+                f"joint_states lacks joint(s) {', '.join(missing)} of the model "
+                f"(it has: {', '.join(names)})"
+            )
+        self._names = list(names)
+        self._index = [where[j] for j in self.joint_names]
+        return self._index
+
+
+def pick(values: Any, index: list[int], what: str, n_names: int) -> list[float]:
+    """The model's joints (floats) out of one JointState field (ValueError on a length mismatch)."""
+    if len(values) != n_names:
+        raise ValueError(f"joint_states {what} has {len(values)} values for {n_names} joints")
+    seq = values.tolist() if isinstance(values, np.ndarray) else values
+    return [float(seq[i]) for i in index]
+
+
+class ObserverNode(LoopNode):
+    """Publishes the estimated contact wrench and external joint effort of any device model."""
+
+    def __init__(self, context: Context | None = None, name: str = "observer_node") -> None:
+        super().__init__(name, context=context)
+        specs = [*loop_specs(), *model_specs(), *specs_of(ObserverSettings)]
+        self.params = ParameterTable(self, specs, self._settings, self._apply)
+        values = self.params.values
+        self.model: DeviceModel = build_model(values)
+        self.period_ns = round(1e9 / values["rate_hz"])
+        self.observer = self._make_observer(self.params.settings)
+        self.joints = JointMap(self.model.joint_names)
+        self._last_ns = -1
+        self.gaps = 0  # samples that came more than one period after the previous one
+        self._prev_q: list[float] | None = None
+        self._bad_input_logged = ""
+        self._wrench = wire.wrench_stamped(values["base_frame"])
+        self._effort = wire.joint_state(self.model.joint_names, values["ee_frame"])
+        self._pub_wrench = RawPublisher(
+            self, SESSION_TOPICS[WRENCH_ESTIMATE], WRENCH_ESTIMATE, qos.LOOP
+        )
+        self._pub_effort = RawPublisher(
+            self, SESSION_TOPICS[EFFORT_ESTIMATE], EFFORT_ESTIMATE, qos.LOOP
+        )
+        raw_subscription(
+            self, SESSION_TOPICS[JOINT_STATES], JOINT_STATES, self._on_joint_states, qos.LOOP_IN
+        )
+        self.create_service(Trigger, "~/reset", self._on_reset)
+
+    @staticmethod
+    def _settings(values: Mapping[str, Any]) -> ObserverSettings:
+        return build(ObserverSettings, values)
+
+    def _make_observer(self, settings: ObserverSettings) -> DisturbanceObserver:
+        return settings.build(self.model, self.period_ns * 1e-9)
+
+    def _apply(self, settings: ObserverSettings) -> None:
+        """A new gain or limit, taken on the next sample without a jump of the estimate."""
+        self.observer.retune(settings.gain, settings.output_limit or None)
+        self.get_logger().info(f"observer now {settings}")
+
+    def _on_reset(self, _req: Trigger.Request, res: Trigger.Response) -> Trigger.Response:
+        self.observer.reset()
+        self._prev_q = None
+        res.success = True
+        res.message = "observer re-zeroed; it re-initialises on the next sample"
+        return res
+
+    def _on_joint_states(self, msg: Any) -> None:
+        st = msg.header.stamp
+        now = to_ns(st.sec, st.nanosec)
+        if now < self._last_ns:
+            return
+        if now == self._last_ns:  # the same sample again: answer it again
+            self._publish(st)
+            return
+        try:
+            idx = self.joints.index(msg.name, len(msg.position))
+            n = len(msg.name) or len(msg.position)
+            q = pick(msg.position, idx, "position", n)
+            if len(msg.velocity):
+                qd = pick(msg.velocity, idx, "velocity", n)
+            elif self._prev_q is not None and now > self._last_ns:
+                dt = (now - self._last_ns) * 1e-9
+                qd = [(a - b) / dt for a, b in zip(q, self._prev_q, strict=True)]
+            else:
+                qd = [0.0] * len(q)
+            tau = pick(msg.effort, idx, "effort", n) if len(msg.effort) else [0.0] * len(q)
+            if not all(map(math.isfinite, q + qd + tau)):
+                raise ValueError("joint_states holds NaN or inf")
+        except ValueError as exc:
+            self._complain(str(exc))
+            return
+        if self._last_ns >= 0 and now - self._last_ns != self.period_ns:
+            self.gaps += 1
+            self.get_logger().warning(
+                f"joint_states jumped {(now - self._last_ns) / self.period_ns:g} periods "
+                f"({self.gaps} gaps so far); the update assumes one",
+                throttle_duration_sec=5.0,
+            )
+        self._prev_q = q
+        self._last_ns = now
+        self.observer.update(q, qd, tau)
+        self._publish(st, q)
+
+    def _publish(self, stamp: Any, q: list[float] | None = None) -> None:
+        if q is not None:
+            force = self.observer.wrench(q)
+            write_force(self._wrench, force)
+            self._effort.effort = self.observer.estimate
+        self._wrench.header.stamp = stamp
+        self._effort.header.stamp = stamp
+        self._pub_wrench.publish(self._wrench)
+        if self._pub_effort.get_subscription_count():
+            self._pub_effort.publish(self._effort)
+
+    def _complain(self, reason: str) -> None:
+        if reason != self._bad_input_logged:  # once per distinct problem, not at 1 kHz
+            self.get_logger().error(f"ignoring joint_states: {reason}")
+            self._bad_input_logged = reason
+
+
+def main(args: list[str] | None = None) -> int:
+    """``ros2 run haptic_dob observer_node``."""
+    return main_for(ObserverNode, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

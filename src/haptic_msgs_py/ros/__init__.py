@@ -1,0 +1,1 @@
+"""The parts of the conventions that need rclpy: QoS profiles, parameter declaration, spinning."""

@@ -1,0 +1,44 @@
+"""QoS profiles of the haptic loop.
+
+Loop publishers are reliable and transient-local and keep the last 2000 samples: a recorder
+(which must not lose a sample) subscribing reliable + transient-local gets every sample even when
+its subscription matched a publisher late after start-up (endpoint matching between processes
+takes a moment) or fell behind, by up to 2000 samples (2 s at 1 kHz).
+
+The loop's own subscriptions are best effort (compatible with a reliable publisher) with a deep
+queue: on one host nothing is lost in practice, and skipping the acknowledgements makes the
+lockstep cycle about 25 % faster on a 2-core machine (BENCHMARKS.md). A lost sample on the
+critical path of a lockstep run stalls it until the device re-sends the sample after
+``lockstep_timeout_s``; every node answers a repeated sample idempotently, so the run stays
+exact. The observer counts gaps in the samples it receives.
+"""
+
+from __future__ import annotations
+
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+LOOP_HISTORY = 2000  # samples a loop publisher keeps for late or slow reliable readers
+LOOP_IN_DEPTH = 1000  # samples a loop subscription queues (a node off the critical path may lag)
+
+LOOP = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=LOOP_HISTORY,
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+)
+
+LOOP_IN = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=LOOP_IN_DEPTH,
+    reliability=ReliabilityPolicy.BEST_EFFORT,
+    durability=DurabilityPolicy.VOLATILE,
+)
+
+CLOCK = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1, reliability=ReliabilityPolicy.RELIABLE)
+
+RECORD = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=LOOP_HISTORY,
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+)

@@ -1,0 +1,146 @@
+"""Run nodes: one context, one executor, our own SIGINT/SIGTERM handling, a clean shutdown.
+
+Jazzy's ``EventsExecutor.spin()`` does not return on SIGINT/SIGTERM; ``spin_once`` with a timeout
+in a loop that watches a signal flag does, and lets nodes do their shutdown work (a device
+zeroes its effort) before the context goes. Nodes may ask to be woken at a time
+(``next_wakeup``) for real-time ticks, and may say they are ``finished``.
+"""
+
+from __future__ import annotations
+
+import gc
+import os
+import signal
+import sys
+import time
+from collections.abc import Callable, Sequence
+
+import rclpy
+from rclpy._rclpy_pybind11 import RCLError
+from rclpy.context import Context
+from rclpy.exceptions import InvalidParameterValueException, ParameterException
+from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+
+EXECUTORS = ("events", "single")
+
+
+class LoopNode(Node):
+    """A node the spin loop can wake at a time, tell to shut down, and ask whether it is done."""
+
+    finished: bool = False
+    exit_code: int = 0
+
+    def next_wakeup(self) -> float | None:
+        """Monotonic time (s) at which ``on_wakeup`` should run, or None."""
+        return None
+
+    def on_wakeup(self, now: float) -> None:
+        """Called at or after ``next_wakeup``."""
+
+    def on_shutdown(self) -> None:
+        """Last work before the node is destroyed (for example: zero the effort)."""
+
+
+def make_executor(kind: str, context: Context) -> Executor:
+    """``events`` (rclpy.experimental.EventsExecutor, the default) or ``single``."""
+    if kind == "events":
+        from rclpy.experimental import EventsExecutor
+
+        return EventsExecutor(context=context)
+    if kind == "single":
+        return SingleThreadedExecutor(context=context)
+    raise ValueError(f"executor must be one of {', '.join(EXECUTORS)}, got {kind!r}")
+
+
+def run_nodes(
+    make_nodes: Callable[[Context], Sequence[Node]],
+    args: Sequence[str] | None = None,
+    executor: str | None = None,
+) -> int:
+    """Create the nodes in a fresh context and spin them until a signal or until one finishes.
+
+    Returns the process exit code: 0 after a clean stop (signal or a node finished), a finished
+    node's non-zero ``exit_code``, or 2 when a parameter was refused at start-up.
+    """
+    kind = executor or os.environ.get("HAPTIC_DOB_EXECUTOR", "events")
+    context = Context()
+    try:
+        rclpy.init(
+            args=list(args) if args is not None else sys.argv,
+            context=context,
+            signal_handler_options=SignalHandlerOptions.NO,
+        )
+    except RCLError as exc:  # a bad --ros-args (for example a params file that does not parse)
+        text = " ".join(str(exc).split()).split(", at /")[0]
+        print(f"ERROR: {text}", file=sys.stderr)
+        return 2
+    received: list[int] = []
+
+    def on_signal(signum: int, _frame: object) -> None:
+        received.append(signum)
+
+    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    nodes: list[Node] = []
+    try:
+        try:
+            nodes = list(make_nodes(context))
+        except InvalidParameterValueException as exc:
+            text = " ".join(str(exc).split())  # "... Reason: <reason>: <name>"
+            reason, _, name = (text.partition("Reason: ")[2] or text).rpartition(": ")
+            print(f"ERROR: parameter {name} refused: {reason}", file=sys.stderr)
+            return 2
+        except (ParameterException, ValueError) as exc:
+            print(f"ERROR: {' '.join(str(exc).split())}", file=sys.stderr)
+            return 2
+        ex = make_executor(kind, context)
+        for n in nodes:
+            ex.add_node(n)
+        loop_nodes = [n for n in nodes if isinstance(n, LoopNode)]
+        gc.collect()
+        gc.freeze()  # keep the collector off the long-lived objects ...
+        gc.set_threshold(50_000, 20, 20)  # ... and run it rarely: the loop makes few cycles
+        profile_dir = os.environ.get("HAPTIC_DOB_PROFILE")
+        if profile_dir:  # developer aid: per-process cProfile of the spin loop
+            import cProfile
+
+            prof = cProfile.Profile()
+            prof.enable()
+        spin_once = ex.spin_once
+        monotonic = time.monotonic
+        done = False
+        while not received and not done and context.ok():
+            timeout = 0.05
+            due_nodes = False
+            for n in loop_nodes:
+                if n.finished:
+                    done = True
+                due = n.next_wakeup()
+                if due is not None:
+                    due_nodes = True
+                    timeout = min(timeout, due - monotonic())
+            if done:
+                break
+            if timeout > 0.0:
+                spin_once(timeout_sec=timeout)
+            if due_nodes:
+                now = monotonic()
+                for n in loop_nodes:
+                    due = n.next_wakeup()
+                    if due is not None and due <= now:
+                        n.on_wakeup(now)
+        if profile_dir:
+            prof.disable()
+            prof.dump_stats(os.path.join(profile_dir, f"{nodes[0].get_name()}.prof"))
+        for n in loop_nodes:
+            n.on_shutdown()
+        ex.shutdown(timeout_sec=1.0)
+        codes = [n.exit_code for n in loop_nodes if n.finished and n.exit_code]
+        return codes[0] if codes else 0
+    finally:
+        for n in nodes:
+            n.destroy_node()
+        rclpy.try_shutdown(context=context)
+        for s, h in old.items():
+            signal.signal(s, h)

@@ -1,0 +1,49 @@
+"""Stamps of the control cycle: sample k of a device at period T carries stamp ``k * T``.
+
+Effort commands travel as ``std_msgs/Float64MultiArray`` (as ros2_control's forward command
+controllers take them), which has no header; the command of cycle k names its cycle in the label
+of its single layout dimension, ``"effort@<stamp_ns>"``. Consumers that ignore the layout (a
+forward command controller) still read the efforts; a command without the label counts as the
+newest one.
+"""
+
+from __future__ import annotations
+
+NS_PER_S = 1_000_000_000
+COMMAND_LABEL = "effort@"
+
+
+def to_ns(sec: int, nanosec: int) -> int:
+    """Integer nanoseconds of a ``builtin_interfaces/Time``."""
+    return sec * NS_PER_S + nanosec
+
+
+def from_ns(ns: int) -> tuple[int, int]:
+    """(sec, nanosec) of integer nanoseconds."""
+    return divmod(ns, NS_PER_S)
+
+
+def stamp_ns(msg: object) -> int:
+    """Nanoseconds of ``msg.header.stamp`` (works for rclpy and rosbags messages)."""
+    st = msg.header.stamp  # type: ignore[attr-defined]
+    return st.sec * NS_PER_S + st.nanosec
+
+
+def period_ns(rate_hz: float) -> int:
+    """Control period of ``rate_hz`` in integer nanoseconds."""
+    return round(NS_PER_S / rate_hz)
+
+
+def command_label(stamp: int) -> str:
+    """The layout label that ties an effort command to its cycle's stamp (ns)."""
+    return f"{COMMAND_LABEL}{stamp}"
+
+
+def command_stamp(label: str) -> int | None:
+    """The stamp (ns) named by a command's layout label, None if it names none."""
+    if label.startswith(COMMAND_LABEL):
+        try:
+            return int(label[len(COMMAND_LABEL) :])
+        except ValueError:
+            return None
+    return None

@@ -1,0 +1,40 @@
+"""Build a simulated device from parameters: the device node and batch runs share it."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from haptic_dob.models.slide import SlideParams
+from haptic_msgs_py.params import ParamSpec, build, specs_of
+from haptic_sim.hand import HandParams
+from haptic_sim.sensor import ForceSensorParams
+from haptic_sim.session import LoopSettings
+from haptic_sim.slide import SimulatedSlide, SlideDeviceParams
+
+
+def simulation_specs() -> list[ParamSpec]:
+    """Sub-steps, seed, length, plant, sensor and hand (read-only: they define the run)."""
+    return [
+        *(s for s in specs_of(LoopSettings, read_only=True) if s.name != "rate_hz"),
+        *specs_of(SlideDeviceParams, "plant.", read_only=True),
+        *specs_of(ForceSensorParams, "sensor.", read_only=True),
+        *specs_of(HandParams, "hand.", read_only=True),
+    ]
+
+
+def build_device(values: Mapping[str, Any]) -> SimulatedSlide:
+    """The simulated device the parameters describe (``model``: slide)."""
+    kind = values.get("model", "slide")
+    if kind != "slide":
+        raise ValueError(f"device_node simulates model slide, got {kind!r}")
+    loop = build(LoopSettings, values)
+    return SimulatedSlide(
+        build(SlideParams, values, "slide."),
+        build(SlideDeviceParams, values, "plant."),
+        build(ForceSensorParams, values, "sensor."),
+        build(HandParams, values, "hand."),
+        loop.rate_hz,
+        loop.substeps,
+        loop.seed,
+    )

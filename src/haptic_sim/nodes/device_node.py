@@ -1,0 +1,330 @@
+"""device_node: a simulated haptic device on the lab network, in lockstep or in real time.
+
+Publishes per sample k (stamp ``k * T``): ``ee_pose``, ``ee_twist``, ``joint_states`` (position,
+velocity, and the effort applied over [k-1, k) after saturation), ``wrench_measured`` (the handle
+force sensor), ``sim/hand_wrench`` (the true hand force, for evaluation) and, in lockstep,
+``/clock``. Takes ``effort_command`` (Float64MultiArray in joint order).
+
+- lockstep: sample 0 goes out once the nodes in ``wait_for`` are up and matched; sample k+1 only
+  after command k (labelled ``effort@<stamp>``, or unlabelled) arrived. If no command comes within
+  ``lockstep_timeout_s`` the node says so and sends sample k again (every node answers a repeated
+  sample idempotently). Stops after ``duration_s`` (0: never).
+- realtime: ticks at ``rate_hz`` and applies the newest valid command; records whether command k
+  arrived before the next tick and its latency (``stats_file``).
+
+Commands of the wrong length or with NaN/inf are refused (counted, logged once per burst).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import time
+from typing import Any
+
+import numpy as np
+from rclpy.context import Context
+
+from haptic_dob.models.factory import model_specs
+from haptic_dob.nodes.common import CLOCK_MODES, loop_specs, main_for
+from haptic_msgs_py import wire
+from haptic_msgs_py.convert import write_force, write_linear, write_position
+from haptic_msgs_py.params import ParamSpec
+from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.params import ParameterTable
+from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
+from haptic_msgs_py.ros.spin import LoopNode
+from haptic_msgs_py.stamps import NS_PER_S, command_stamp
+from haptic_msgs_py.topics import (
+    CLOCK,
+    EE_POSE,
+    EE_TWIST,
+    EFFORT_COMMAND,
+    HAND_WRENCH,
+    JOINT_STATES,
+    SESSION_TOPICS,
+    WRENCH_MEASURED,
+)
+from haptic_sim.device import DeviceSample
+from haptic_sim.factory import build_device, simulation_specs
+
+DEFAULT_WAIT_FOR = ["environment_node", "observer_node", "controller_node"]
+STARTUP_RESEND_S = 0.5
+
+
+def device_node_specs() -> list[ParamSpec]:
+    """Every parameter of the device node."""
+    return [
+        *loop_specs(),
+        *model_specs(),
+        ParamSpec(
+            "clock_mode",
+            "lockstep",
+            "lockstep: advance when command k arrived; realtime: tick at rate_hz",
+            choices=CLOCK_MODES,
+            read_only=True,
+        ),
+        *simulation_specs(),
+        ParamSpec(
+            "lockstep_timeout_s",
+            2.0,
+            "lockstep: warn and re-send a sample after this long without its command",
+            "s",
+            0.01,
+            3600.0,
+        ),
+        ParamSpec(
+            "wait_for",
+            list(DEFAULT_WAIT_FOR),
+            "lockstep: nodes (in this namespace) that must be up before sample 0",
+            read_only=True,
+        ),
+        ParamSpec(
+            "start_delay_s",
+            0.5,
+            "lockstep: settle time between the graph being up and "
+            "sample 0 (endpoint matching between the other nodes)",
+            "s",
+            0.0,
+            60.0,
+            read_only=True,
+        ),
+        ParamSpec(
+            "stats_file",
+            "",
+            "realtime: write cycle statistics (JSON) here at shutdown",
+            read_only=True,
+        ),
+    ]
+
+
+class DeviceNode(LoopNode):
+    """A simulated device stepping in the cycle contract."""
+
+    def __init__(self, context: Context | None = None, name: str = "device_node") -> None:
+        super().__init__(name, context=context)
+        self.params = ParameterTable(self, device_node_specs())
+        v = self.params.values
+        self.device = build_device(v)
+        self.dof = self.device.dof
+        self.period_ns = self.device.period_ns
+        self.lockstep = v["clock_mode"] == "lockstep"
+        cycles = round(v["duration_s"] * v["rate_hz"])
+        self.last_k = cycles if cycles > 0 else None  # the run ends after publishing sample N
+        # messages, filled in place each cycle; one shared stamp object
+        self._stamp = wire.Time(sec=0, nanosec=0)
+        base, ee = v["base_frame"], v["ee_frame"]
+        self._pose, self._twist = wire.pose_stamped(base), wire.twist_stamped(base)
+        self._measured, self._hand = wire.wrench_stamped(base), wire.wrench_stamped(base)
+        self._js = wire.joint_state(self.device.model.joint_names, ee)
+        self._clock = wire.clock()
+        for m in (self._pose, self._twist, self._measured, self._hand, self._js):
+            m.header.stamp = self._stamp
+        self._clock.clock = self._stamp
+
+        def pub(topic: str) -> RawPublisher:
+            return RawPublisher(self, SESSION_TOPICS[topic], topic, qos.LOOP)
+
+        self._p_pose, self._p_twist = pub(EE_POSE), pub(EE_TWIST)
+        self._p_js, self._p_measured, self._p_hand = (
+            pub(JOINT_STATES),
+            pub(WRENCH_MEASURED),
+            pub(HAND_WRENCH),
+        )
+        self._p_clock = (
+            RawPublisher(self, "rosgraph_msgs/msg/Clock", CLOCK, qos.CLOCK)
+            if self.lockstep
+            else None
+        )
+        self._sub = raw_subscription(
+            self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, self._on_command, qos.LOOP_IN
+        )
+        self._zero = [0.0] * self.dof
+        self._latest = self._zero
+        self._last_command_s = 0.0
+        self.refused = 0
+        self._refusing = False
+        self._started = False
+        self._ready_since: float | None = None
+        self._t_first = 0.0
+        self._deadline = time.monotonic() + 0.1
+        self._sent_s = 0.0
+        # real-time statistics
+        self._on_time = 0
+        self._late = 0
+        self._missed_ticks = 0
+        self._latency_s: list[float] = []
+        self._command_k = -1
+        mode = "lockstep" if self.lockstep else f"realtime at {v['rate_hz']:g} Hz"
+        self.get_logger().info(f"simulated {v['model']} device, {mode}")
+
+    # --- publishing ------------------------------------------------------------------------
+    def _publish(self, s: DeviceSample) -> None:
+        self._sent_s = time.monotonic()
+        st = self._stamp
+        st.sec, st.nanosec = divmod(s.stamp_ns, NS_PER_S)
+        write_position(self._pose, s.ee_position)
+        self._p_pose.publish(self._pose)
+        write_linear(self._twist, s.ee_velocity)
+        self._p_twist.publish(self._twist)
+        js = self._js
+        js.position, js.velocity, js.effort = np.array(s.q), np.array(s.qd), np.array(s.effort)
+        self._p_js.publish(js)
+        write_force(self._measured, s.wrench_measured)
+        self._p_measured.publish(self._measured)
+        # evaluation-only topics: skip the serialisation when nobody listens
+        if self._p_hand.get_subscription_count():
+            write_force(self._hand, s.hand_force)
+            self._p_hand.publish(self._hand)
+        if self._p_clock is not None and self._p_clock.get_subscription_count():
+            self._p_clock.publish(self._clock)
+
+    # --- commands --------------------------------------------------------------------------
+    def _valid(self, data: Any) -> list[float] | None:
+        data = data.tolist()
+        if len(data) != self.dof or not all(map(math.isfinite, data)):
+            self.refused += 1
+            if not self._refusing:
+                self.get_logger().warning(
+                    f"refusing effort_command {list(data)!r}: need {self.dof} finite values"
+                )
+                self._refusing = True
+            return None
+        self._refusing = False
+        return data
+
+    def _on_command(self, msg: Any) -> None:
+        dims = msg.layout.dim
+        stamp = command_stamp(dims[0].label) if dims else None
+        current = self.device.k * self.period_ns
+        if self.lockstep:
+            if not self._started or (stamp is not None and stamp != current):
+                return  # stale, duplicate, or before the run started
+            effort = self._valid(msg.data)
+            if effort is None:
+                return
+            self._step(effort)
+            return
+        effort = self._valid(msg.data)
+        if effort is None:
+            return
+        now = time.monotonic()
+        self._latest = effort
+        self._last_command_s = now
+        if stamp == current and self.device.k != self._command_k:
+            self._command_k = self.device.k
+            self._on_time += 1
+            self._latency_s.append(now - self._sent_s)
+
+    def _step(self, effort: list[float]) -> None:
+        self.device.apply(effort)
+        s = self.device.sample()
+        self._publish(s)
+        self._deadline = self._sent_s + self.params.values["lockstep_timeout_s"]
+        if self.last_k is not None and s.k >= self.last_k:
+            self.finished = True
+            wall = time.monotonic() - self._t_first
+            sim = s.k * self.period_ns * 1e-9
+            self.get_logger().info(
+                f"finished: {s.k} cycles ({sim:g} s simulated) in {wall:.2f} s, "
+                f"real-time factor {sim / wall:.2f}"
+            )
+
+    # --- time ------------------------------------------------------------------------------
+    def next_wakeup(self) -> float | None:
+        return self._deadline
+
+    def on_wakeup(self, now: float) -> None:
+        if not self.lockstep:
+            self._tick(now)
+            return
+        if not self._started:
+            if self._ready_since is None:
+                if self._graph_ready():
+                    self._ready_since = now
+                    self._deadline = now + self.params.values["start_delay_s"]
+                else:
+                    self._deadline = now + 0.05
+                return
+            self._started = True
+            self._t_first = now
+            self._publish(self.device.sample())
+            self._deadline = now + STARTUP_RESEND_S
+            return
+        k = self.device.k
+        if k == 0:
+            self._publish(self.device.sample())  # start-up: a late subscriber may have missed it
+            self._deadline = now + STARTUP_RESEND_S
+            return
+        self.get_logger().warning(
+            f"no {EFFORT_COMMAND} for cycle {k} (stamp {k * self.period_ns * 1e-9:.3f} s) within "
+            f"{self.params.values['lockstep_timeout_s']:g} s; is controller_node running and "
+            "receiving its inputs? Sending the sample again."
+        )
+        self._publish(self.device.sample())
+        self._deadline = now + self.params.values["lockstep_timeout_s"]
+
+    def _graph_ready(self) -> bool:
+        """Every ``wait_for`` node is up, known subscribers matched, a command publisher seen."""
+        ns = self.get_namespace()
+        names = {n for n, space in self.get_node_names_and_namespaces() if space == ns}
+        if any(w not in names for w in self.params.values["wait_for"]):
+            return False
+        for pub, topic in (
+            (self._p_js, JOINT_STATES),
+            (self._p_pose, EE_POSE),
+            (self._p_twist, EE_TWIST),
+            (self._p_measured, WRENCH_MEASURED),
+        ):
+            if pub.get_subscription_count() < self.count_subscribers(topic):
+                return False
+        return self._sub.get_publisher_count() >= 1 or not self.params.values["wait_for"]
+
+    def _tick(self, now: float) -> None:
+        period = self.period_ns * 1e-9
+        if not self._started:
+            self._started = True
+            self._t_first = now
+            self._publish(self.device.sample())
+            self._deadline = now + period
+            return
+        if self._command_k != self.device.k:
+            self._late += 1
+        self._step(self._latest)
+        self._deadline += period
+        if now - self._deadline > period:  # fell behind by more than a period: resynchronise
+            self._missed_ticks += int((now - self._deadline) / period)
+            self._deadline = now + period
+
+    # --- end -------------------------------------------------------------------------------
+    def stats(self) -> dict[str, Any]:
+        """Real-time cycle statistics so far."""
+        lat = np.array(self._latency_s) if self._latency_s else np.array([np.nan])
+        total = self._on_time + self._late
+        return {
+            "cycles": self.device.k,
+            "commands_on_time": self._on_time,
+            "commands_late": self._late,
+            "on_time_pct": 100.0 * self._on_time / total if total else math.nan,
+            "missed_ticks": self._missed_ticks,
+            "latency_p50_ms": float(np.percentile(lat, 50) * 1e3),
+            "latency_p99_ms": float(np.percentile(lat, 99) * 1e3),
+            "refused_commands": self.refused,
+        }
+
+    def on_shutdown(self) -> None:
+        self._latest = self._zero
+        path = self.params.values["stats_file"]
+        if path and not self.lockstep:
+            with open(path, "w", encoding="utf-8") as fh:
+                json.dump(self.stats(), fh, indent=2)
+
+
+def main(args: list[str] | None = None) -> int:
+    """``ros2 run haptic_sim device_node``."""
+    return main_for(DeviceNode, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

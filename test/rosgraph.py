@@ -1,0 +1,207 @@
+"""Helpers for tests that start ROS 2 processes: isolated domains, launched graphs, collectors.
+
+Every multi-process test runs on its own random ``ROS_DOMAIN_ID`` with discovery limited to this
+host, waits with timeouts only, and kills what it started by process group.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import random
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+BIN = Path(sys.executable).parent
+
+
+def isolated_env(domain: int | None = None) -> dict[str, str]:
+    """This environment with a random domain id and localhost-only discovery."""
+    env = dict(os.environ)
+    env["ROS_DOMAIN_ID"] = str(domain if domain is not None else random.randint(1, 100))
+    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    env.pop("ROS_STATIC_PEERS", None)
+    return env
+
+
+class Process:
+    """A child process in its own session, stopped with SIGINT then killed if it lingers."""
+
+    def __init__(self, argv: list[str], env: dict[str, str], log: Path | None = None) -> None:
+        self.log_path = log
+        self._log = open(log, "w") if log else subprocess.DEVNULL  # noqa: SIM115
+        self.proc = subprocess.Popen(
+            argv, env=env, stdout=self._log, stderr=subprocess.STDOUT, start_new_session=True
+        )
+
+    def wait(self, timeout: float) -> int:
+        """Wait for the exit code (raises ``subprocess.TimeoutExpired``)."""
+        return self.proc.wait(timeout)
+
+    def stop(self, timeout: float = 10.0) -> int | None:
+        """SIGINT the process group, wait, then SIGKILL it."""
+        if self.proc.poll() is None:
+            try:
+                os.killpg(self.proc.pid, signal.SIGINT)
+                self.proc.wait(timeout)
+            except (subprocess.TimeoutExpired, ProcessLookupError):
+                pass
+        if self.proc.poll() is None:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(self.proc.pid, signal.SIGKILL)
+            self.proc.wait(5)
+        if self._log is not subprocess.DEVNULL:
+            self._log.close()
+        return self.proc.returncode
+
+    def output(self) -> str:
+        """What the process wrote so far (when logging to a file)."""
+        return self.log_path.read_text() if self.log_path else ""
+
+
+def launch(
+    config: str,
+    env: dict[str, str],
+    sets: Iterable[str] = (),
+    log: Path | None = None,
+    extra: Iterable[str] = (),
+) -> Process:
+    """``haptic-launch CONFIG --set ...`` as a child process."""
+    argv = [str(BIN / "haptic-launch"), config, *extra]
+    for s in sets:
+        argv += ["--set", s]
+    return Process(argv, env, log)
+
+
+class Collector:
+    """An in-test node (private context) that records raw messages of some topics.
+
+    ``records[topic]`` is a list of (receive time, CDR bytes); ``messages(topic)`` decodes them.
+    Subscriptions are reliable, so a collector added to the device's ``wait_for`` sees every
+    sample of a lockstep run. Storing bytes keeps it fast enough for several 2 kHz topics.
+    """
+
+    def __init__(
+        self,
+        env: dict[str, str],
+        topics: dict[str, str],
+        name: str = "collector",
+        namespace: str = "",
+    ) -> None:
+        import rclpy
+        from rclpy.context import Context
+        from rclpy.executors import SingleThreadedExecutor
+
+        from haptic_msgs_py.ros.qos import RECORD
+        from haptic_msgs_py.ros.raw import rclpy_type
+
+        self._saved = {
+            k: os.environ.get(k) for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")
+        }
+        os.environ["ROS_DOMAIN_ID"] = env["ROS_DOMAIN_ID"]
+        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = env["ROS_AUTOMATIC_DISCOVERY_RANGE"]
+        self.context = Context()
+        rclpy.init(context=self.context, args=[])
+        self.node = rclpy.create_node(name, namespace=namespace or None, context=self.context)
+        qos = RECORD  # reliable, transient local: late matching loses nothing
+        self.topics = dict(topics)
+        self.records: dict[str, list[tuple[float, bytes]]] = {t: [] for t in topics}
+        self._lock = threading.Lock()
+        for topic, typename in topics.items():
+
+            def cb(data: bytes, topic: str = topic) -> None:
+                with self._lock:
+                    self.records[topic].append((time.monotonic(), data))
+
+            self.node.create_subscription(rclpy_type(typename), topic, cb, qos, raw=True)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._spin, daemon=True)
+        self._thread.start()
+
+    def _spin(self) -> None:
+        while not self._stop.is_set() and self.context.ok():
+            self.executor.spin_once(timeout_sec=0.05)
+
+    def count(self, topic: str) -> int:
+        with self._lock:
+            return len(self.records[topic])
+
+    def wait_for(self, topic: str, n: int, timeout: float) -> bool:
+        """Wait until ``n`` messages of ``topic`` arrived (False on timeout)."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if self.count(topic) >= n:
+                return True
+            time.sleep(0.02)
+        return self.count(topic) >= n
+
+    def messages(self, topic: str) -> list[Any]:
+        """The decoded (rosbags) messages of ``topic`` received so far."""
+        from haptic_msgs_py.wire import decoder
+
+        decode = decoder(self.topics[topic])
+        with self._lock:
+            raw = [m for _, m in self.records[topic]]
+        return [decode(m) for m in raw]
+
+    def close(self) -> None:
+        import rclpy
+
+        self._stop.set()
+        self._thread.join(5)
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+        for k, v in self._saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def set_parameter(env: dict[str, str], node: str, name: str, value: Any, timeout: float = 10.0):
+    """Call ``/<node>/set_parameters`` like ``ros2 param set``; returns (successful, reason)."""
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.parameter import Parameter
+
+    saved = {k: os.environ.get(k) for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")}
+    os.environ["ROS_DOMAIN_ID"] = env["ROS_DOMAIN_ID"]
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = env["ROS_AUTOMATIC_DISCOVERY_RANGE"]
+    ctx = Context()
+    rclpy.init(context=ctx, args=[])
+    try:
+        from rcl_interfaces.srv import SetParameters
+
+        n = rclpy.create_node(f"param_client_{random.randint(0, 10**6)}", context=ctx)
+        cli = n.create_client(SetParameters, f"/{node.lstrip('/')}/set_parameters")
+        if not cli.wait_for_service(timeout_sec=timeout):
+            raise TimeoutError(f"/{node}/set_parameters did not appear within {timeout} s")
+        req = SetParameters.Request(parameters=[Parameter(name, value=value).to_parameter_msg()])
+        from rclpy.executors import SingleThreadedExecutor
+
+        ex = SingleThreadedExecutor(context=ctx)
+        ex.add_node(n)
+        fut = cli.call_async(req)
+        ex.spin_until_future_complete(fut, timeout_sec=timeout)
+        ex.shutdown()
+        if not fut.done():
+            raise TimeoutError(f"/{node}/set_parameters did not answer within {timeout} s")
+        res = fut.result().results[0]
+        n.destroy_node()
+        return res.successful, res.reason
+    finally:
+        rclpy.try_shutdown(context=ctx)
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v

@@ -1,0 +1,147 @@
+"""Nodes in-process with a private Context: parameter tables, descriptors and refusals."""
+
+from __future__ import annotations
+
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.parameter import Parameter
+
+from haptic_dob.nodes.controller_node import ControllerNode
+from haptic_dob.nodes.environment_node import EnvironmentNode
+from haptic_dob.nodes.observer_node import ObserverNode
+from haptic_sim.nodes.device_node import DeviceNode
+from rosgraph import isolated_env
+
+NODES = [DeviceNode, EnvironmentNode, ObserverNode, ControllerNode]
+
+
+@pytest.fixture
+def context(monkeypatch: pytest.MonkeyPatch):
+    env = isolated_env()
+    monkeypatch.setenv("ROS_DOMAIN_ID", env["ROS_DOMAIN_ID"])
+    ctx = Context()
+    rclpy.init(context=ctx, args=[])
+    yield ctx
+    rclpy.try_shutdown(context=ctx)
+
+
+@pytest.mark.parametrize("cls", NODES, ids=lambda c: c.__name__)
+def test_every_parameter_has_a_description_and_ranges(cls, context) -> None:
+    node = cls(context=context)
+    try:
+        for name, spec in node.params.specs.items():
+            d = node.describe_parameter(name)
+            assert d.description, name
+            if spec.kind in (float, int) and spec.min is not None and spec.max is not None:
+                ranges = d.floating_point_range if spec.kind is float else d.integer_range
+                assert len(ranges) == 1, name
+                assert (ranges[0].from_value, ranges[0].to_value) == (spec.min, spec.max)
+            assert d.read_only == spec.read_only, name
+    finally:
+        node.destroy_node()
+
+
+def test_structural_parameters_are_read_only(context) -> None:
+    dev = DeviceNode(context=context)
+    ctl = ControllerNode(context=context)
+    try:
+        for name in ("model", "clock_mode", "rate_hz", "seed", "slide.mass_kg", "hand.behaviour"):
+            assert dev.describe_parameter(name).read_only, name
+        res = dev.set_parameters([Parameter("slide.mass_kg", value=1.0)])[0]
+        assert not res.successful and "read-only" in res.reason
+        for name in ("mode", "kf", "max_force_n"):
+            assert not ctl.describe_parameter(name).read_only, name
+    finally:
+        dev.destroy_node()
+        ctl.destroy_node()
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "reason"),
+    [
+        ("mode", "PID", r"mode must be one of OL, CL, DOB"),
+        # rclpy checks the declared range first and says so itself
+        ("kf", -1.0, r"kf out of range Min: 0.0, Max: 10000.0|kf must be >= 0"),
+        ("kf", "two", r"kf must be a number"),
+        ("max_force_n", 0.0, r"max_force_n out of range|max_force_n must be >= 0.001"),
+    ],
+)
+def test_controller_refuses_bad_values_and_keeps_the_law(context, name, value, reason) -> None:
+    import re
+
+    ctl = ControllerNode(context=context)
+    try:
+        before = ctl.controller.law
+        res = ctl.set_parameters([Parameter(name, value=value)])[0]
+        assert not res.successful and re.search(reason, res.reason), res.reason
+        assert ctl.controller.law is before
+        assert ctl.get_parameter(name).value == ctl.params.values[name]
+    finally:
+        ctl.destroy_node()
+
+
+def test_controller_takes_good_values_at_once(context) -> None:
+    ctl = ControllerNode(context=context)
+    try:
+        assert ctl.set_parameters([Parameter("kf", value=3)])[0].successful  # int for a double
+        assert ctl.controller.law.kf == 3.0
+        assert ctl.set_parameters([Parameter("max_force_n", value=2.5)])[0].successful
+        assert ctl.controller.law.max_force_n == 2.5
+    finally:
+        ctl.destroy_node()
+
+
+def test_switch_to_dob_is_refused_until_the_observer_is_warm(context) -> None:
+    ctl = ControllerNode(context=context)
+    try:
+        res = ctl.set_parameters([Parameter("mode", value="DOB")])[0]
+        assert not res.successful and "wrench_estimate" in res.reason
+        assert ctl.controller.law.mode.value == "OL"
+        period = ctl.period_ns
+        for k in range(30):  # estimates and wall forces of 30 consecutive cycles
+            ctl.estimated.take(k * period, (0.0, 0.0, 0.0))
+            ctl._note(k * period)
+        assert ctl.set_parameters([Parameter("mode", value="DOB")])[0].successful
+        assert ctl.controller.law.mode.value == "DOB"
+        res = ctl.set_parameters([Parameter("mode", value="CL")])[0]
+        assert not res.successful and "wrench_measured" in res.reason
+    finally:
+        ctl.destroy_node()
+
+
+def test_environment_wall_changes_at_run_time_and_refuses_a_zero_normal(context) -> None:
+    env = EnvironmentNode(context=context)
+    try:
+        assert env.set_parameters([Parameter("stiffness_n_per_m", value=1600.0)])[0].successful
+        assert env.wall.stiffness_n_per_m == 1600.0
+        res = env.set_parameters([Parameter("normal", value=[0.0, 0.0, 0.0])])[0]
+        assert not res.successful and "normal must be a non-zero vector" in res.reason
+        assert env.wall.normal == (1.0, 0.0, 0.0)
+        res = env.set_parameters([Parameter("position", value=[0.0, 1.0])])[0]
+        assert not res.successful and "3 elements" in res.reason
+    finally:
+        env.destroy_node()
+
+
+def test_observer_retunes_without_a_jump_and_refuses_a_bad_gain(context) -> None:
+    obs = ObserverNode(context=context)
+    try:
+        assert obs.set_parameters([Parameter("gain", value=10.0)])[0].successful
+        assert obs.observer.gain == 10.0
+        res = obs.set_parameters([Parameter("gain", value=0.0)])[0]
+        assert not res.successful and obs.observer.gain == 10.0
+        assert obs.set_parameters([Parameter("output_limit", value=0.0)])[0].successful
+        assert obs.observer.limit is None
+    finally:
+        obs.destroy_node()
+
+
+def test_bad_start_values_fail_the_node_with_the_reason() -> None:
+    ctx = Context()
+    rclpy.init(context=ctx, args=["--ros-args", "-p", "kf:=-2.0"])
+    try:
+        with pytest.raises(Exception, match="kf"):
+            ControllerNode(context=ctx)
+    finally:
+        rclpy.try_shutdown(context=ctx)
