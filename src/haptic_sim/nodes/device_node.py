@@ -8,7 +8,10 @@ force sensor), ``sim/hand_wrench`` (the true hand force, for evaluation) and, in
 - lockstep: sample 0 goes out once the nodes in ``wait_for`` are up and matched; sample k+1 only
   after command k (labelled ``effort@<stamp>``, or unlabelled) arrived. If no command comes within
   ``lockstep_timeout_s`` the node says so and sends sample k again (every node answers a repeated
-  sample idempotently). Stops after ``duration_s`` (0: never).
+  sample idempotently). While a recorder reports its progress (``recorder/progress``), the device
+  also holds the next sample when the recorder lags more than ``max_recorder_lag_s`` of simulated
+  time, so a recording of a lockstep run never loses a sample. Stops after ``duration_s``
+  (0: never).
 - realtime: ticks at ``rate_hz`` and applies the newest valid command; records whether command k
   arrived before the next tick and its latency (``stats_file``).
 
@@ -43,6 +46,7 @@ from haptic_msgs_py.topics import (
     EFFORT_COMMAND,
     HAND_WRENCH,
     JOINT_STATES,
+    RECORDER_PROGRESS,
     SESSION_TOPICS,
     WRENCH_MEASURED,
 )
@@ -140,6 +144,12 @@ class DeviceNode(LoopNode):
         self._sub = raw_subscription(
             self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, self._on_command, qos.LOOP_IN
         )
+        self._recorder_ns: int | None = None  # newest stamp a recorder has written
+        self._held: list[float] | None = None  # a command waiting for the recorder
+        if self.lockstep:
+            raw_subscription(
+                self, "rosgraph_msgs/msg/Clock", RECORDER_PROGRESS, self._on_progress, qos.CLOCK
+            )
         self._zero = [0.0] * self.dof
         self._latest = self._zero
         self._last_command_s = 0.0
@@ -204,6 +214,9 @@ class DeviceNode(LoopNode):
             effort = self._valid(msg.data)
             if effort is None:
                 return
+            if self._recorder_lags():
+                self._held = effort  # the recorder's progress callback releases it
+                return
             self._step(effort)
             return
         effort = self._valid(msg.data)
@@ -216,6 +229,20 @@ class DeviceNode(LoopNode):
             self._command_k = self.device.k
             self._on_time += 1
             self._latency_s.append(now - self._sent_s)
+
+    def _on_progress(self, msg: Any) -> None:
+        st = msg.clock
+        self._recorder_ns = st.sec * NS_PER_S + st.nanosec
+        if self._held is not None and not self._recorder_lags():
+            effort, self._held = self._held, None
+            self._step(effort)
+
+    def _recorder_lags(self) -> bool:
+        """A recorder is connected and more than ``max_recorder_lag_s`` behind sample k."""
+        if self._recorder_ns is None:
+            return False
+        lead = self.device.k * self.period_ns - self._recorder_ns
+        return lead > self.params.values["max_recorder_lag_s"] * NS_PER_S
 
     def _step(self, effort: list[float]) -> None:
         self.device.apply(effort)
@@ -253,6 +280,20 @@ class DeviceNode(LoopNode):
             self._deadline = now + STARTUP_RESEND_S
             return
         k = self.device.k
+        if self._held is not None:  # waiting for the recorder, not for a command
+            if self.count_publishers(RECORDER_PROGRESS) == 0:  # the recorder is gone: go on
+                self.get_logger().warning("the recorder stopped reporting; the loop goes on")
+                self._recorder_ns = None
+                effort, self._held = self._held, None
+                self._step(effort)
+                return
+            self._deadline = now + self.params.values["lockstep_timeout_s"]
+            self.get_logger().warning(
+                "holding the loop: the recorder is "
+                f"{(k * self.period_ns - (self._recorder_ns or 0)) * 1e-9:.2f} s behind",
+                throttle_duration_sec=5.0,
+            )
+            return
         if k == 0:
             self._publish(self.device.sample())  # start-up: a late subscriber may have missed it
             self._deadline = now + STARTUP_RESEND_S
