@@ -64,18 +64,110 @@ def bench_observer_update(repeat: int) -> str:
     return f"median {statistics.median(runs):.2f} us per update (min {min(runs):.2f})"
 
 
+def _launch(extra: list[str], sets: list[str], timeout: float) -> str:
+    """Run ``haptic-launch slide_sim`` on a fresh domain; return its combined output."""
+    import random
+    import subprocess
+
+    env = dict(
+        os.environ,
+        ROS_DOMAIN_ID=str(random.randint(1, 100)),
+        ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+    )
+    argv = [os.path.join(os.path.dirname(sys.executable), "haptic-launch"), "slide_sim", *extra]
+    for item in sets:
+        argv += ["--set", item]
+    out = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=timeout)
+    if out.returncode != 0:
+        raise RuntimeError(f"haptic-launch failed ({out.returncode}): {out.stderr[-2000:]}")
+    return out.stdout + out.stderr
+
+
+def _lockstep(repeat: int, extra: list[str]) -> str:
+    import re
+
+    rtf = []
+    for _ in range(repeat):
+        text = _launch(extra, ["device_node:duration_s=20.0"], 300)
+        rtf.append(float(re.search(r"real-time factor ([0-9.]+)", text).group(1)))
+    per_cycle_us = 1e3 / statistics.median(rtf)
+    return (
+        f"real-time factor median {statistics.median(rtf):.2f} (runs: "
+        f"{', '.join(f'{r:.2f}' for r in sorted(rtf))}) -> {per_cycle_us:.0f} us per cycle"
+    )
+
+
+def bench_lockstep(repeat: int) -> str:
+    """The 4-process lockstep graph at 1 kHz, 20 s simulated: real-time factor."""
+    return _lockstep(repeat, [])
+
+
+def bench_lockstep_composed(repeat: int) -> str:
+    """The same graph composed in one process under one executor."""
+    return _lockstep(repeat, ["--composed"])
+
+
+def _realtime(repeat: int, extra: list[str]) -> str:
+    import json
+    import tempfile
+
+    rows = []
+    for _ in range(repeat):
+        with tempfile.TemporaryDirectory() as tmp:
+            stats = os.path.join(tmp, "stats.json")
+            _launch(
+                extra,
+                [
+                    "device_node:clock_mode=realtime",
+                    "device_node:duration_s=20.0",
+                    f"device_node:stats_file={stats}",
+                ],
+                300,
+            )
+            with open(stats, encoding="utf-8") as fh:
+                rows.append(json.load(fh))
+    med = {
+        k: statistics.median(r[k] for r in rows)
+        for k in ("on_time_pct", "latency_p50_ms", "latency_p99_ms", "missed_ticks")
+    }
+    runs = ", ".join(f"{r['on_time_pct']:.2f}" for r in rows)
+    return (
+        f"commands before the next tick: median {med['on_time_pct']:.2f} % (runs: "
+        f"{runs}); sample-to-command latency "
+        f"p50 {med['latency_p50_ms']:.3f} ms, p99 {med['latency_p99_ms']:.3f} ms; "
+        f"missed ticks {med['missed_ticks']:g} of 20000"
+    )
+
+
+def bench_realtime(repeat: int) -> str:
+    """The 4-process graph in real time at 1 kHz for 20 s: on-time share and latency."""
+    return _realtime(repeat, [])
+
+
+def bench_realtime_composed(repeat: int) -> str:
+    """The same, composed in one process."""
+    return _realtime(repeat, ["--composed"])
+
+
 BENCHMARKS: dict[str, Callable[[int], str]] = {
     "batch": bench_batch_session,
     "observer": bench_observer_update,
+    "lockstep": bench_lockstep,
+    "lockstep-composed": bench_lockstep_composed,
+    "realtime": bench_realtime,
+    "realtime-composed": bench_realtime_composed,
 }
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the named benchmarks (default: all) and print one line each."""
     p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("names", nargs="*", choices=[*BENCHMARKS, []], help="benchmarks to run")
+    p.add_argument("names", nargs="*", help=f"benchmarks to run: {', '.join(BENCHMARKS)}")
     p.add_argument("--repeat", type=int, default=5, help="repetitions (median reported)")
     a = p.parse_args(argv)
+    unknown = [n for n in a.names if n not in BENCHMARKS]
+    if unknown:
+        p.error(f"unknown benchmark(s) {', '.join(unknown)}; choose from {', '.join(BENCHMARKS)}")
     print(f"machine: {machine()}")
     for name in a.names or list(BENCHMARKS):
         print(f"{name}: {BENCHMARKS[name](a.repeat)}", flush=True)

@@ -36,6 +36,8 @@ class SimulatedDevice(Protocol):
 
     model: DeviceModel
     period_ns: int
+    dof: int
+    max_effort: tuple[float, ...]  # actuator saturation per joint (N or N m)
 
     @property
     def k(self) -> int: ...

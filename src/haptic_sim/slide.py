@@ -88,6 +88,7 @@ class SimulatedSlide:
         self.dt = self.period_ns * 1e-9
         self.dt_physics = self.dt / self.substeps
         self.model = self.physics.model()
+        self.max_effort = (self.device.max_force_n,)  # actuator saturation per joint
         self._axis = tuple(float(a) for a in self.model.axis)
         hand_rng, sensor_rng = (
             np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2)

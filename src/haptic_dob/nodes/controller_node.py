@@ -7,6 +7,13 @@ of stamp k the mode needs has arrived, labelled with its stamp (``effort@<ns>``)
 and ``max_force_n`` change at run time: the next command uses the new law, with no other state to
 carry (bumpless). A switch to CL or DOB is refused while its force input is not flowing (the
 observer must be warm before DOB takes over).
+
+Fallback: when the force input the mode needs stops (the observer died in DOB, the sensor stream in
+CL) -- its newest sample is ``input_timeout_s`` older than the cycle, or a cycle waited that long
+for it -- the controller renders with ``fallback`` (``zero``: no force; ``OL``: the wall force
+alone), says so, and returns to its mode once the input flows again (warm, as for a switch).
+Without the wall force (``wrench_desired``) it sends nothing and the device's watchdog zeroes the
+effort. ``/diagnostics`` reports the mode, the fallback state and the inputs still awaited.
 """
 
 from __future__ import annotations
@@ -28,6 +35,7 @@ from haptic_msgs_py import wire
 from haptic_msgs_py.convert import read_force
 from haptic_msgs_py.params import ParamSpec, build, specs_of
 from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_msgs_py.ros.params import ParameterTable
 from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
 from haptic_msgs_py.ros.spin import LoopNode
@@ -86,6 +94,21 @@ class ControllerNode(LoopNode):
                 0.01,
                 3600.0,
             ),
+            ParamSpec(
+                "fallback",
+                "zero",
+                "what to render when the mode's force input stops: zero force or OL",
+                choices=("zero", "OL"),
+            ),
+            ParamSpec(
+                "input_timeout_s",
+                0.02,
+                "the mode's force input counts as stopped after this long (wall time for a waiting "
+                "cycle, stamp time for its newest sample)",
+                "s",
+                0.001,
+                10.0,
+            ),
         ]
         self.params = ParameterTable(self, specs, self._settings, self._apply)
         values = self.params.values
@@ -103,6 +126,8 @@ class ControllerNode(LoopNode):
         self._needs_q = not self.model.constant_jacobian
         self._pending_since = 0.0
         self._warned_ns = -1
+        self.fallback_reason: str | None = None
+        self.fallbacks = 0
         self._cmd = wire.float64_multi_array("", [0.0] * self.model.dof)
         self._dim = self._cmd.layout.dim[0]
         self._pub = RawPublisher(self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, qos.LOOP)
@@ -115,6 +140,7 @@ class ControllerNode(LoopNode):
             inputs.append((JOINT_STATES, self._on_joint_states))
         for topic, callback in inputs:
             raw_subscription(self, SESSION_TOPICS[topic], topic, callback, qos.LOOP_IN)
+        self.diagnostics = Diagnostics(self, self._report)
 
     # --- parameters ------------------------------------------------------------------------
     def _settings(self, values: Mapping[str, Any]) -> ImpedanceLaw:
@@ -177,6 +203,17 @@ class ControllerNode(LoopNode):
         if self.controller.law.mode is ControlMode.DOB:
             self._emit()
 
+    def _force_input(self) -> tuple[_Input, str] | None:
+        """The hand-force input the current mode needs, with its topic (None in OL)."""
+        need = self.controller.law.needs
+        if need is None:
+            return None
+        return (
+            (self.measured, WRENCH_MEASURED)
+            if need == "measured"
+            else (self.estimated, WRENCH_ESTIMATE)
+        )
+
     # --- the law ---------------------------------------------------------------------------
     def _emit(self) -> None:
         k = self._newest_ns
@@ -184,33 +221,110 @@ class ControllerNode(LoopNode):
             return
         if self._needs_q and self.js.stamp != k:
             return
-        mode = self.controller.law.mode
-        if (mode is ControlMode.CL and self.measured.stamp != k) or (
-            mode is ControlMode.DOB and self.estimated.stamp != k
-        ):
-            return
+        force = self._force_input()
+        if force is not None:
+            src, topic = force
+            if src.stamp == k:
+                if self.fallback_reason and src.flowing(k, self.period_ns):
+                    self.fallback_reason = None
+                    self.get_logger().info(f"{topic} flows again: back to {self._mode()}")
+            elif not self.fallback_reason:
+                timeout_ns = self.params.values["input_timeout_s"] * 1e9
+                if k - src.stamp <= timeout_ns:
+                    return  # on its way: wait for it (on_wakeup gives up after input_timeout_s)
+                self._fall_back(f"{topic} silent for {(k - src.stamp) * 1e-6:.0f} ms of samples")
         if k != self._sent_ns:
-            tau = self.controller.command(
-                self.js.value, self.desired.value, self.measured.value, self.estimated.value
-            )
+            if self.fallback_reason is None:
+                tau = self.controller.command(
+                    self.js.value, self.desired.value, self.measured.value, self.estimated.value
+                )
+            elif self.params.values["fallback"] == "OL":
+                tau = self._open_loop.command(self.js.value, self.desired.value)
+            else:
+                tau = [0.0] * self.model.dof
             self._cmd.data = np.array(tau)
             self._dim.label = command_label(k)
             self._sent_ns = k
+            self.diagnostics.tick()
         self._pub.publish(self._cmd)  # a repeated sample gets the same command again
 
+    def _mode(self) -> str:
+        law = self.controller.law
+        return law.mode.value if law.mode is ControlMode.OL else f"{law.mode.value} (Kf {law.kf:g})"
+
+    @property
+    def _open_loop(self) -> ImpedanceController:
+        """OL with the current force limit (the OL fallback)."""
+        limit = self.controller.law.max_force_n
+        ol = getattr(self, "_ol", None)
+        if ol is None or ol.law.max_force_n != limit:
+            self._ol = ImpedanceController(self.model, ImpedanceLaw(ControlMode.OL, 0.0, limit))
+        return self._ol
+
+    def _fall_back(self, reason: str) -> None:
+        self.fallback_reason = reason
+        self.fallbacks += 1
+        self.get_logger().warning(
+            f"{self._mode()} lost its input ({reason}): rendering "
+            f"{self.params.values['fallback']} until it flows again"
+        )
+
     def next_wakeup(self) -> float | None:
-        """While a cycle is pending, look again at the time its inputs are overdue."""
-        if self._newest_ns > self._sent_ns and self._newest_ns != self._warned_ns:
+        """While a cycle is pending: when to give up on its force input, or to warn."""
+        if self._newest_ns <= self._sent_ns:
+            return None
+        force = self._force_input()
+        if (
+            force is not None
+            and not self.fallback_reason
+            and self.desired.stamp == self._newest_ns
+            and force[0].stamp != self._newest_ns
+        ):
+            return self._pending_since + self.params.values["input_timeout_s"]
+        if self._newest_ns != self._warned_ns:
             return self._pending_since + self.params.values["input_warn_s"]
         return None
 
     def on_wakeup(self, now: float) -> None:
-        """Name the inputs a pending cycle still lacks (once per cycle)."""
+        """Fall back for a cycle whose force input is overdue, or name what it lacks (once)."""
+        force = self._force_input()
+        if (
+            force is not None
+            and not self.fallback_reason
+            and self.desired.stamp == self._newest_ns
+            and force[0].stamp != self._newest_ns
+        ):
+            waited = now - self._pending_since
+            self._fall_back(f"{force[1]} of the cycle {waited * 1e3:.0f} ms late")
+            self._emit()
+            return
         self._warned_ns = self._newest_ns
         self.get_logger().warning(
             f"cycle at stamp {self._newest_ns * 1e-9:.3f} s still lacks "
             f"{', '.join(self.missing_inputs())} after {now - self._pending_since:.1f} s"
         )
+
+    def _report(self) -> Report:
+        law = self.controller.law
+        values = {
+            "mode": law.mode.value,
+            "kf": law.kf,
+            "max_force_n": law.max_force_n,
+            "fallback": f"active ({self.params.values['fallback']}): {self.fallback_reason}"
+            if self.fallback_reason
+            else "inactive",
+            "fallbacks": self.fallbacks,
+            "awaiting": ", ".join(self.missing_inputs()) if self._newest_ns > self._sent_ns else "",
+        }
+        if self.fallback_reason:
+            return (
+                WARN,
+                f"fallback {self.params.values['fallback']}: {self.fallback_reason}",
+                values,
+            )
+        if self.diagnostics.cycles and self.diagnostics.rate_hz == 0.0:
+            return WARN, "no commands in the last second: inputs missing", values
+        return OK, f"running {self._mode()}", values
 
     def missing_inputs(self) -> list[str]:
         """The inputs of the newest pending cycle the current mode still waits for."""

@@ -14,6 +14,7 @@ from haptic_msgs_py import wire
 from haptic_msgs_py.convert import read_linear, read_position, write_force
 from haptic_msgs_py.params import build, specs_of
 from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_msgs_py.ros.params import ParameterTable
 from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
 from haptic_msgs_py.ros.spin import LoopNode
@@ -35,6 +36,19 @@ class EnvironmentNode(LoopNode):
         self._pub = RawPublisher(self, SESSION_TOPICS[WRENCH_DESIRED], WRENCH_DESIRED, qos.LOOP)
         raw_subscription(self, SESSION_TOPICS[EE_POSE], EE_POSE, self._on_pose, qos.LOOP_IN)
         raw_subscription(self, SESSION_TOPICS[EE_TWIST], EE_TWIST, self._on_twist, qos.LOOP_IN)
+        self.diagnostics = Diagnostics(self, self._report)
+
+    def _report(self) -> Report:
+        w = self.wall
+        values = {
+            "stiffness_n_per_m": w.stiffness_n_per_m,
+            "damping_n_s_per_m": w.damping_n_s_per_m,
+            "position": list(w.position),
+            "normal": list(w.normal),
+        }
+        if self.diagnostics.rate_hz == 0.0:
+            return WARN, "no ee_pose/ee_twist pairs in the last second", values
+        return OK, "rendering", values
 
     @staticmethod
     def _settings(values: Mapping[str, Any]) -> VirtualWall:
@@ -64,6 +78,7 @@ class EnvironmentNode(LoopNode):
         out.header.stamp = a
         write_force(out, force)
         self._pub.publish(out)
+        self.diagnostics.tick()
 
 
 def main(args: list[str] | None = None) -> int:

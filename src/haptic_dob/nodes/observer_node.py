@@ -25,6 +25,7 @@ from haptic_msgs_py import wire
 from haptic_msgs_py.convert import write_force
 from haptic_msgs_py.params import build, specs_of
 from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.diagnostics import ERROR, OK, WARN, Diagnostics, Report
 from haptic_msgs_py.ros.params import ParameterTable
 from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
 from haptic_msgs_py.ros.spin import LoopNode
@@ -99,6 +100,22 @@ class ObserverNode(LoopNode):
             self, SESSION_TOPICS[JOINT_STATES], JOINT_STATES, self._on_joint_states, qos.LOOP_IN
         )
         self.create_service(Trigger, "~/reset", self._on_reset)
+        self.diagnostics = Diagnostics(self, self._report)
+
+    def _report(self) -> Report:
+        values = {
+            "model": self.params.values["model"],
+            "gain": self.observer.gain,
+            "output_limit": self.params.values["output_limit"],
+            "initialised": self.observer.initialised,
+            "sample_gaps": self.gaps,
+            "bad_input": self._bad_input_logged or "none",
+        }
+        if self._bad_input_logged and self.diagnostics.rate_hz == 0.0:
+            return ERROR, f"ignoring joint_states: {self._bad_input_logged}", values
+        if self.diagnostics.rate_hz == 0.0:
+            return WARN, "no joint_states in the last second", values
+        return OK, "estimating", values
 
     @staticmethod
     def _settings(values: Mapping[str, Any]) -> ObserverSettings:
@@ -153,7 +170,9 @@ class ObserverNode(LoopNode):
             )
         self._prev_q = q
         self._last_ns = now
+        self._bad_input_logged = ""
         self.observer.update(q, qd, tau)
+        self.diagnostics.tick()
         self._publish(st, q)
 
     def _publish(self, stamp: Any, q: list[float] | None = None) -> None:

@@ -87,6 +87,17 @@ class ParameterTable:
         self._declaring = False
         self.settings = validate(self.values) if validate else None
 
+    def set_validator(
+        self,
+        validate: Callable[[Mapping[str, Any]], Any],
+        apply: Callable[[Any], None] | None = None,
+    ) -> Any:
+        """Install the whole-snapshot validator later (when it needs objects built from the
+        start-up values); validates the current values now and returns the settings."""
+        self._validate, self._apply = validate, apply
+        self.settings = validate(self.values)
+        return self.settings
+
     def _on_set(self, params: list[Parameter]) -> SetParametersResult:
         proposed = dict(self.values)
         for p in params:

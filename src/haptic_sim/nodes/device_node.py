@@ -15,7 +15,12 @@ force sensor), ``sim/hand_wrench`` (the true hand force, for evaluation) and, in
 - realtime: ticks at ``rate_hz`` and applies the newest valid command; records whether command k
   arrived before the next tick and its latency (``stats_file``).
 
-Commands of the wrong length or with NaN/inf are refused (counted, logged once per burst).
+Safety (every path, both modes): each joint's effort is clamped to ``effort_limits`` (at most the
+actuator's own saturation; changeable at run time); a command of the wrong length or with NaN/inf
+is refused and counts as zero effort (counted, logged once per burst); in real time a watchdog
+zeroes the effort when no valid command came for ``command_timeout_s`` and says so, and the next
+valid command resumes; at shutdown the effort goes to zero first. ``/diagnostics`` reports the
+loop rate, deadline misses, the watchdog, refused and limited commands.
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ import json
 import math
 import sys
 import time
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -35,6 +41,7 @@ from haptic_msgs_py import wire
 from haptic_msgs_py.convert import write_force, write_linear, write_position
 from haptic_msgs_py.params import ParamSpec
 from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_msgs_py.ros.params import ParameterTable
 from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
 from haptic_msgs_py.ros.spin import LoopNode
@@ -60,6 +67,20 @@ STARTUP_RESEND_S = 0.5
 def device_node_specs() -> list[ParamSpec]:
     """Every parameter of the device node."""
     return [
+        ParamSpec(
+            "command_timeout_s",
+            0.005,
+            "realtime watchdog: zero effort when no valid command came for this long",
+            "s",
+            0.0005,
+            1.0,
+        ),
+        ParamSpec(
+            "effort_limits",
+            [0.0],
+            "per-joint effort limit (N or N m) applied to every command, at most the actuator's "
+            "saturation; [0.0] = the actuator's saturation",
+        ),
         *loop_specs(),
         *model_specs(),
         ParamSpec(
@@ -112,6 +133,8 @@ class DeviceNode(LoopNode):
         v = self.params.values
         self.device = build_device(v)
         self.dof = self.device.dof
+        self.hardware_limits = tuple(self.device.max_effort)
+        self.limits: tuple[float, ...] = self.params.set_validator(self._limits, self._set_limits)
         self.period_ns = self.device.period_ns
         self.lockstep = v["clock_mode"] == "lockstep"
         cycles = round(v["duration_s"] * v["rate_hz"])
@@ -122,10 +145,10 @@ class DeviceNode(LoopNode):
         self._pose, self._twist = wire.pose_stamped(base), wire.twist_stamped(base)
         self._measured, self._hand = wire.wrench_stamped(base), wire.wrench_stamped(base)
         self._js = wire.joint_state(self.device.model.joint_names, ee)
-        self._clock = wire.clock()
+        self._clock_msg = wire.clock()
         for m in (self._pose, self._twist, self._measured, self._hand, self._js):
             m.header.stamp = self._stamp
-        self._clock.clock = self._stamp
+        self._clock_msg.clock = self._stamp
 
         def pub(topic: str) -> RawPublisher:
             return RawPublisher(self, SESSION_TOPICS[topic], topic, qos.LOOP)
@@ -152,9 +175,12 @@ class DeviceNode(LoopNode):
             )
         self._zero = [0.0] * self.dof
         self._latest = self._zero
-        self._last_command_s = 0.0
+        self._last_command_s = -math.inf
         self.refused = 0
+        self.limited = 0
         self._refusing = False
+        self.watchdog_tripped = False
+        self.watchdog_trips = 0
         self._started = False
         self._ready_since: float | None = None
         self._t_first = 0.0
@@ -166,8 +192,30 @@ class DeviceNode(LoopNode):
         self._missed_ticks = 0
         self._latency_s: list[float] = []
         self._command_k = -1
+        self.diagnostics = Diagnostics(self, self._report)
         mode = "lockstep" if self.lockstep else f"realtime at {v['rate_hz']:g} Hz"
-        self.get_logger().info(f"simulated {v['model']} device, {mode}")
+        self.get_logger().info(
+            f"simulated {v['model']} device, {mode}, effort limits {list(self.limits)}"
+        )
+
+    # --- parameters -------------------------------------------------------------------------
+    def _limits(self, values: Mapping[str, Any]) -> tuple[float, ...]:
+        """The per-joint limits a set of values asks for (ValueError with the reason if refused)."""
+        asked = list(values["effort_limits"])
+        if asked == [0.0]:
+            return self.hardware_limits
+        if len(asked) != self.dof:
+            raise ValueError(f"effort_limits needs {self.dof} values (one per joint), got {asked}")
+        for i, (a, hw) in enumerate(zip(asked, self.hardware_limits, strict=True)):
+            if not 0.0 < a <= hw:
+                raise ValueError(
+                    f"effort_limits[{i}] must be in (0, {hw:g}] (actuator saturation), got {a}"
+                )
+        return tuple(float(a) for a in asked)
+
+    def _set_limits(self, limits: tuple[float, ...]) -> None:
+        self.limits = limits
+        self.get_logger().info(f"effort limits now {list(limits)}")
 
     # --- publishing ------------------------------------------------------------------------
     def _publish(self, s: DeviceSample) -> None:
@@ -188,21 +236,30 @@ class DeviceNode(LoopNode):
             write_force(self._hand, s.hand_force)
             self._p_hand.publish(self._hand)
         if self._p_clock is not None and self._p_clock.get_subscription_count():
-            self._p_clock.publish(self._clock)
+            self._p_clock.publish(self._clock_msg)
 
     # --- commands --------------------------------------------------------------------------
-    def _valid(self, data: Any) -> list[float] | None:
+    def _checked(self, data: Any) -> list[float] | None:
+        """The command clamped to the limits, or None when it is refused (wrong length, NaN)."""
         data = data.tolist()
         if len(data) != self.dof or not all(map(math.isfinite, data)):
             self.refused += 1
             if not self._refusing:
                 self.get_logger().warning(
-                    f"refusing effort_command {list(data)!r}: need {self.dof} finite values"
+                    f"refusing effort_command {data!r}: need {self.dof} finite values; "
+                    "zero effort until a valid command"
                 )
                 self._refusing = True
             return None
         self._refusing = False
-        return data
+        out = data
+        for i, (e, lim) in enumerate(zip(data, self.limits, strict=True)):
+            if e > lim or e < -lim:
+                if out is data:
+                    out = list(data)
+                    self.limited += 1
+                out[i] = lim if e > 0 else -lim
+        return out
 
     def _on_command(self, msg: Any) -> None:
         dims = msg.layout.dim
@@ -211,20 +268,24 @@ class DeviceNode(LoopNode):
         if self.lockstep:
             if not self._started or (stamp is not None and stamp != current):
                 return  # stale, duplicate, or before the run started
-            effort = self._valid(msg.data)
+            effort = self._checked(msg.data)
             if effort is None:
-                return
+                effort = self._zero  # a refused command is zero effort; the loop goes on
             if self._recorder_lags():
                 self._held = effort  # the recorder's progress callback releases it
                 return
             self._step(effort)
             return
-        effort = self._valid(msg.data)
+        effort = self._checked(msg.data)
         if effort is None:
+            self._latest = self._zero
             return
         now = time.monotonic()
         self._latest = effort
         self._last_command_s = now
+        if self.watchdog_tripped:
+            self.watchdog_tripped = False
+            self.get_logger().info("valid effort_command again: effort resumed")
         if stamp == current and self.device.k != self._command_k:
             self._command_k = self.device.k
             self._on_time += 1
@@ -248,7 +309,9 @@ class DeviceNode(LoopNode):
         self.device.apply(effort)
         s = self.device.sample()
         self._publish(s)
-        self._deadline = self._sent_s + self.params.values["lockstep_timeout_s"]
+        self.diagnostics.tick()
+        if self.lockstep:
+            self._deadline = self._sent_s + self.params.values["lockstep_timeout_s"]
         if self.last_k is not None and s.k >= self.last_k:
             self.finished = True
             wall = time.monotonic() - self._t_first
@@ -330,9 +393,21 @@ class DeviceNode(LoopNode):
             self._publish(self.device.sample())
             self._deadline = now + period
             return
-        if self._command_k != self.device.k:
-            self._late += 1
-        self._step(self._latest)
+        if self._command_k != self.device.k and self._on_time:
+            self._late += 1  # counted once the loop has closed (the first command came)
+        effort = self._latest
+        if now - self._last_command_s > self.params.values["command_timeout_s"]:
+            effort = self._zero
+            if not self.watchdog_tripped:
+                self.watchdog_tripped = True
+                self.watchdog_trips += 1
+                silent = now - self._last_command_s
+                self.get_logger().warning(
+                    f"watchdog: no valid {EFFORT_COMMAND} for "
+                    f"{'ever' if math.isinf(silent) else f'{silent * 1e3:.1f} ms'} "
+                    f"(limit {self.params.values['command_timeout_s'] * 1e3:g} ms): effort zeroed"
+                )
+        self._step(effort)
         self._deadline += period
         if now - self._deadline > period:  # fell behind by more than a period: resynchronise
             self._missed_ticks += int((now - self._deadline) / period)
@@ -352,14 +427,44 @@ class DeviceNode(LoopNode):
             "latency_p50_ms": float(np.percentile(lat, 50) * 1e3),
             "latency_p99_ms": float(np.percentile(lat, 99) * 1e3),
             "refused_commands": self.refused,
+            "limited_commands": self.limited,
+            "watchdog_trips": self.watchdog_trips,
         }
 
+    def _report(self) -> Report:
+        values: dict[str, Any] = {
+            "clock_mode": "lockstep" if self.lockstep else "realtime",
+            "cycle": self.device.k,
+            "watchdog": "tripped: effort zeroed" if self.watchdog_tripped else "ok",
+            "watchdog_trips": self.watchdog_trips,
+            "refused_commands": self.refused,
+            "limited_commands": self.limited,
+            "effort_limits": list(self.limits),
+        }
+        if not self.lockstep:
+            values.update(
+                deadline_misses=self._missed_ticks,
+                late_commands=self._late,
+                on_time_commands=self._on_time,
+            )
+        if self.watchdog_tripped:
+            return WARN, "watchdog tripped: no valid effort_command, effort zeroed", values
+        if self._refusing:
+            return WARN, "refusing invalid effort_command (zero effort)", values
+        if not self._started:
+            return OK, "waiting for the graph", values
+        return OK, "running", values
+
     def on_shutdown(self) -> None:
-        self._latest = self._zero
+        """Zero effort first; in real time one last period runs and is reported with it."""
         path = self.params.values["stats_file"]
         if path and not self.lockstep:
             with open(path, "w", encoding="utf-8") as fh:
                 json.dump(self.stats(), fh, indent=2)
+        self._latest = self._zero
+        if not self.lockstep and self._started:
+            self._step(self._zero)
+        self.get_logger().info("shutdown: effort zeroed")
 
 
 def main(args: list[str] | None = None) -> int:

@@ -1,0 +1,71 @@
+"""The ros2 launch file: installed, and it plans the same nodes as haptic-launch.
+
+The ROS 2 command line (launch, launch_ros) is not installed here; the test gives the file
+minimal stand-ins for those modules and checks what it asks launch_ros to start.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+import types
+from pathlib import Path
+
+from ament_index_python.packages import get_package_share_directory
+
+
+class _Recorder:
+    """Stand-in launch classes that remember their arguments."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        self.args, self.kwargs = args, kwargs
+
+
+def _stub_modules(monkeypatch, launch_args: dict[str, str]) -> None:
+    launch = types.ModuleType("launch")
+    launch.LaunchDescription = _Recorder
+    actions = types.ModuleType("launch.actions")
+    actions.DeclareLaunchArgument = _Recorder
+    actions.OpaqueFunction = _Recorder
+    subs = types.ModuleType("launch.substitutions")
+
+    class LaunchConfiguration:
+        def __init__(self, name: str) -> None:
+            self.name = name
+
+        def perform(self, context) -> str:
+            return launch_args[self.name]
+
+    subs.LaunchConfiguration = LaunchConfiguration
+    ros = types.ModuleType("launch_ros")
+    ros_actions = types.ModuleType("launch_ros.actions")
+    ros_actions.Node = _Recorder
+    for name, mod in {"launch": launch, "launch.actions": actions,
+                      "launch.substitutions": subs, "launch_ros": ros,
+                      "launch_ros.actions": ros_actions}.items():
+        monkeypatch.setitem(sys.modules, name, mod)
+
+
+def test_launch_file_is_installed_and_plans_the_session(monkeypatch) -> None:
+    path = Path(get_package_share_directory("haptic_dob")) / "launch" / "session.launch.py"
+    assert path.is_file()
+    _stub_modules(monkeypatch, {"config": "slide_sim", "namespace": "slide1"})
+    spec = importlib.util.spec_from_file_location("session_launch", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    ld = module.generate_launch_description()
+    opaque = ld.args[0][-1]
+    nodes = opaque.kwargs["function"](context=None)
+    planned = [(n.kwargs["package"], n.kwargs["executable"], n.kwargs["namespace"]) for n in nodes]
+    assert planned == [
+        ("haptic_dob", "environment_node", "slide1"),
+        ("haptic_dob", "observer_node", "slide1"),
+        ("haptic_dob", "controller_node", "slide1"),
+        ("haptic_sim", "device_node", "slide1"),
+    ]
+    device = nodes[-1].kwargs["parameters"][0]
+    assert device["clock_mode"] == "lockstep" and device["rate_hz"] == 1000.0
+    assert device["hand.behaviour"] == "semi_random"
+    for pkg, exe, _ in planned:
+        shim = Path(get_package_share_directory(pkg)).parents[1] / "lib" / pkg / exe
+        assert shim.is_file(), shim

@@ -1,0 +1,128 @@
+"""haptic-launch: the graph from one config, Ctrl-C forwarding, composition, bad input."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+from conftest import tool
+from haptic_msgs_py.topics import JOINT_STATES, SESSION_TOPICS
+from haptic_sim.session import SessionConfig, run_session
+from rosgraph import Collector, isolated_env, launch
+
+NODE_EXES = ("haptic-device-node", "haptic-environment-node", "haptic-observer-node",
+             "haptic-controller-node")
+
+
+def children_of(pid: int) -> list[int]:
+    """PIDs whose parent is ``pid``."""
+    out = subprocess.run(["ps", "-o", "pid=", "--ppid", str(pid)], capture_output=True, text=True)
+    return [int(p) for p in out.stdout.split()]
+
+
+def alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    state = subprocess.run(["ps", "-o", "stat=", "-p", str(pid)], capture_output=True, text=True)
+    return bool(state.stdout.strip()) and not state.stdout.strip().startswith("Z")
+
+
+@pytest.mark.multiprocess
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_signal_to_the_launcher_stops_every_node_cleanly(root, tmp_path, sig) -> None:
+    env = isolated_env()
+    log = tmp_path / "launch.log"
+    proc = subprocess.Popen(
+        [tool("haptic-launch"), str(root / "config" / "slide_sim.yaml"),
+         "--set", "device_node:clock_mode=realtime", "--set", "device_node:duration_s=0.0"],
+        env=env, stdout=open(log, "w"), stderr=subprocess.STDOUT,  # noqa: SIM115
+    )
+    try:
+        deadline = time.monotonic() + 30
+        kids: list[int] = []
+        while time.monotonic() < deadline and len(kids) < 4:
+            kids = children_of(proc.pid)
+            time.sleep(0.2)
+        assert len(kids) == 4, log.read_text()
+        time.sleep(2.0)  # let the loop run
+        proc.send_signal(sig)
+        assert proc.wait(30) == 0, log.read_text()
+        for pid in kids:
+            assert not alive(pid), f"node {pid} survived the launcher"
+        text = log.read_text()
+        assert "Traceback" not in text and "did not stop" not in text, text
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        for pid in children_of(proc.pid):
+            os.kill(pid, signal.SIGKILL)
+
+
+@pytest.mark.multiprocess
+@pytest.mark.slow
+def test_composed_graph_reproduces_the_batch_run(root, tmp_path) -> None:
+    """All nodes in one process under one executor: the same trajectory as the batch run."""
+    env = isolated_env()
+    col = Collector(env, {JOINT_STATES: SESSION_TOPICS[JOINT_STATES]})
+    graph = launch(str(root / "config" / "slide_sim.yaml"), env,
+                   ["device_node:wait_for=[environment_node, observer_node, controller_node, "
+                    "collector]", "device_node:duration_s=2.0", "controller_node:mode=DOB",
+                    "controller_node:kf=1.0"], tmp_path / "launch.log", extra=["--composed"])
+    try:
+        assert graph.wait(120) == 0, graph.output()
+        assert col.wait_for(JOINT_STATES, 2001, 10)
+    finally:
+        graph.stop()
+        col.close()
+    q = np.array([m.position[0] for m in col.messages(JOINT_STATES)])
+    cfg = SessionConfig.from_yaml(root / "config" / "slide_sim.yaml").replace(
+        loop__duration_s=2.0, law__mode="DOB", law__kf=1.0
+    )
+    assert np.array_equal(q[:2000], run_session(cfg).q)
+
+
+def launch_cli(*args: str, env=None) -> subprocess.CompletedProcess:
+    return subprocess.run([tool("haptic-launch"), *args], capture_output=True, text=True,
+                          timeout=60, env=env or isolated_env())
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["no_such_config"], "ERROR: no config 'no_such_config'"),
+        (["slide_sim", "--set", "controller_node"], "ERROR: --set needs NODE:PARAM=VALUE"),
+        (["slide_sim", "--set", "pilot_node:kf=1"], "ERROR: --set names unknown node 'pilot_node'"),
+        (["slide_sim", "--set", "controller_node:kf=[1"], "the value is not valid YAML"),
+    ],
+)
+def test_bad_input_gets_one_error_line(args, message) -> None:
+    out = launch_cli(*args)
+    assert out.returncode == 2, out.stderr
+    assert message in out.stderr and "Traceback" not in out.stderr
+
+
+def test_config_errors_are_reported(tmp_path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("pilot_node:\n  ros__parameters: {kf: 1}\n")
+    out = launch_cli(str(bad))
+    assert out.returncode == 2 and "unknown node(s) pilot_node" in out.stderr
+    bad.write_text("controller_node: [1, 2\n")
+    out = launch_cli(str(bad))
+    assert out.returncode == 2 and "is not valid YAML" in out.stderr
+    bad.write_text("controller_node:\n  kf: 1\n")
+    out = launch_cli(str(bad))
+    assert out.returncode == 2 and "has no ros__parameters" in out.stderr
+
+
+@pytest.mark.multiprocess
+def test_a_refused_node_parameter_stops_the_graph_with_its_reason(root, tmp_path) -> None:
+    out = launch_cli(str(root / "config" / "slide_sim.yaml"), "--set", "controller_node:kf=-3")
+    assert out.returncode == 1
+    assert "parameter kf refused" in out.stderr and "controller_node exited with code 2" in out.stderr
