@@ -109,7 +109,13 @@ class Collector:
         self.context = Context()
         rclpy.init(context=self.context, args=[])
         self.node = rclpy.create_node(name, namespace=namespace or None, context=self.context)
-        qos = RECORD  # reliable, transient local: late matching loses nothing
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+        from haptic_msgs_py.topics import SESSION_TOPICS
+
+        # loop topics: reliable + transient local (late matching loses nothing); others, such as
+        # /diagnostics, are offered volatile
+        volatile = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
         self.topics = dict(topics)
         self.records: dict[str, list[tuple[float, bytes]]] = {t: [] for t in topics}
         self._lock = threading.Lock()
@@ -119,6 +125,7 @@ class Collector:
                 with self._lock:
                     self.records[topic].append((time.monotonic(), data))
 
+            qos = RECORD if topic in SESSION_TOPICS else volatile
             self.node.create_subscription(rclpy_type(typename), topic, cb, qos, raw=True)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
@@ -205,3 +212,30 @@ def set_parameter(env: dict[str, str], node: str, name: str, value: Any, timeout
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
+
+
+def start_nodes(config: Path, env: dict[str, str], sets: Iterable[str], log_dir: Path,
+                namespace: str = "") -> dict[str, Process]:
+    """Each node of ``config`` as its own process via ``<prefix>/lib/<pkg>/<exe>`` (no launcher,
+    so a test can kill and restart single nodes)."""
+    from haptic_dob.launcher import parse_sets, plan, resolved_params, write_params_file
+
+    params = resolved_params(config, parse_sets(list(sets)))
+    params_file = write_params_file(params, log_dir)
+    procs = {}
+    for spec in plan(params, params_file, namespace):
+        procs[spec.name] = Process([spec.executable, *spec.ros_args], env,
+                                   log_dir / f"{spec.name}.log")
+    return procs
+
+
+def restart(procs: dict[str, Process], name: str, env: dict[str, str], log_dir: Path,
+            config: Path, sets: Iterable[str]) -> None:
+    """Start node ``name`` again with the same parameters."""
+    from haptic_dob.launcher import parse_sets, plan, resolved_params, write_params_file
+
+    params = resolved_params(config, parse_sets(list(sets)))
+    params_file = write_params_file(params, log_dir)
+    spec = next(s for s in plan(params, params_file, "") if s.name == name)
+    procs[name] = Process([spec.executable, *spec.ros_args], env,
+                          log_dir / f"{name}.restarted.log")

@@ -285,7 +285,9 @@ class DeviceNode(LoopNode):
         self._last_command_s = now
         if self.watchdog_tripped:
             self.watchdog_tripped = False
-            self.get_logger().info("valid effort_command again: effort resumed")
+            self.get_logger().info(
+                "valid effort_command again: effort resumed", throttle_duration_sec=1.0
+            )
         if stamp == current and self.device.k != self._command_k:
             self._command_k = self.device.k
             self._on_time += 1
@@ -405,7 +407,9 @@ class DeviceNode(LoopNode):
                 self.get_logger().warning(
                     f"watchdog: no valid {EFFORT_COMMAND} for "
                     f"{'ever' if math.isinf(silent) else f'{silent * 1e3:.1f} ms'} "
-                    f"(limit {self.params.values['command_timeout_s'] * 1e3:g} ms): effort zeroed"
+                    f"(limit {self.params.values['command_timeout_s'] * 1e3:g} ms): effort zeroed "
+                    f"({self.watchdog_trips} trips so far)",
+                    throttle_duration_sec=1.0,
                 )
         self._step(effort)
         self._deadline += period

@@ -1,0 +1,119 @@
+"""Faults in real time: a node killed with SIGKILL stops the force at once; a restart resumes.
+
+The graph runs with each node in its own process (started through the ros2 run contract, not the
+launcher, so one can be killed). The test measures, on the device's own sample clock, how long
+after the last command the applied effort (``joint_states.effort``) reaches zero, reads why from
+``/diagnostics``, restarts the node and sees the force come back.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+
+import numpy as np
+import pytest
+
+from haptic_msgs_py.stamps import stamp_ns
+from haptic_msgs_py.topics import DIAGNOSTICS, JOINT_STATES, SESSION_TOPICS
+from rosgraph import Collector, isolated_env, restart, start_nodes
+
+pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
+
+TIMEOUT_S = 0.005  # the device's command_timeout_s default
+PERIOD_S = 0.001
+
+
+def efforts(col: Collector) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(receive time, stamp s, effort) of every joint_states so far."""
+    from haptic_msgs_py.wire import decoder
+
+    decode = decoder(SESSION_TOPICS[JOINT_STATES])
+    with col._lock:
+        raw = list(col.records[JOINT_STATES])
+    msgs = [(t, decode(b)) for t, b in raw]
+    return (np.array([t for t, _ in msgs]), np.array([stamp_ns(m) * 1e-9 for _, m in msgs]),
+            np.array([m.effort[0] for _, m in msgs]))
+
+
+def diagnostics_after(col: Collector, t0: float) -> list[str]:
+    """Status messages published after ``t0`` (test-process monotonic time)."""
+    from haptic_msgs_py.wire import decoder
+
+    decode = decoder("diagnostic_msgs/msg/DiagnosticArray")
+    with col._lock:
+        raw = [b for t, b in col.records[DIAGNOSTICS] if t > t0]
+    return [f"{s.name}: {s.message}" for b in raw for s in decode(b).status]
+
+
+@pytest.mark.parametrize(
+    ("victim", "mode", "reason"),
+    [
+        ("controller_node", "OL", "device_node: watchdog tripped"),
+        ("observer_node", "DOB", "controller_node: fallback zero: wrench_estimate"),
+        ("environment_node", "OL", "device_node: watchdog tripped"),
+    ],
+)
+def test_kill_9_zeroes_the_force_within_the_command_timeout(root, tmp_path, victim, mode,
+                                                            reason) -> None:
+    env = isolated_env()
+    config = root / "config" / "slide_sim.yaml"
+    sets = ["device_node:clock_mode=realtime", "device_node:duration_s=0.0",
+            f"controller_node:mode={mode}", "controller_node:kf=1.0"]
+    col = Collector(env, {JOINT_STATES: SESSION_TOPICS[JOINT_STATES],
+                          DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray"})
+    procs = start_nodes(config, env, sets, tmp_path)
+    try:
+        # the loop runs: the hand pushes into the wall, the effort is the wall's push-back
+        deadline = time.monotonic() + 40
+        while time.monotonic() < deadline:
+            _, _, e = efforts(col)
+            if e.size > 500 and np.all(np.abs(e[-200:]) > 0.1):
+                break
+            time.sleep(0.2)
+        else:
+            pytest.fail("the loop did not close: " + procs["device_node"].output()[-2000:])
+        t_kill = time.monotonic()
+        os.kill(procs[victim].proc.pid, signal.SIGKILL)
+        procs[victim].proc.wait(5)
+        time.sleep(1.0)
+        t, stamps, e = efforts(col)
+        before = t < t_kill
+        after = ~before
+        # the force is zero from some sample after the kill to the end (the node stays dead)
+        nonzero = np.nonzero(e != 0.0)[0]
+        assert nonzero.size and nonzero[-1] < e.size - 1, "the effort never went to zero"
+        first_zero = nonzero[-1] + 1
+        assert stamps[first_zero] > stamps[before][-1] - 0.1
+        # before it, the device held the last command it got (the same value, sample after sample)
+        # until the watchdog or the controller's fallback zeroed it: measured on the device clock
+        held = 0
+        while held + 1 <= nonzero[-1] and e[nonzero[-1] - held - 1] == e[nonzero[-1]]:
+            held += 1
+        latency = stamps[first_zero] - stamps[nonzero[-1] - held]
+        assert latency <= TIMEOUT_S + 2 * PERIOD_S, f"{latency * 1e3:.1f} ms"
+        deadline = time.monotonic() + 5  # diagnostics come once a second
+        while time.monotonic() < deadline:
+            statuses = diagnostics_after(col, t_kill)
+            if any(reason in s for s in statuses):
+                break
+            time.sleep(0.2)
+        assert any(reason in s for s in statuses), statuses
+        # bring the node back: the force comes back
+        t_restart = time.monotonic()
+        restart(procs, victim, env, tmp_path, config, sets)
+        deadline = time.monotonic() + 40
+        while time.monotonic() < deadline:
+            t, _, e = efforts(col)
+            if np.sum(np.abs(e[t > t_restart]) > 0.1) > 200:
+                break
+            time.sleep(0.2)
+        else:
+            pytest.fail(f"the loop did not resume after restarting {victim}")
+        assert np.any(e[-100:] != 0.0)
+        assert after.any()
+    finally:
+        for p in procs.values():
+            p.stop()
+        col.close()
