@@ -8,6 +8,12 @@ is forwarded to every node as SIGINT (each shuts down cleanly: the device zeroes
 the launcher waits for them, killing what is still alive after ``--stop-timeout``. When the
 device finishes a lockstep run (``duration_s``) the others are stopped too. ``--composed`` runs
 all nodes in this one process under one executor instead.
+
+Network: by default every node's discovery stays on this host
+(``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), so a simulated session never reaches a lab network
+by accident. ``--network subnet`` lets them discover across the subnet, ``--peers`` adds named
+hosts (``ROS_STATIC_PEERS``), and ``--only`` starts a subset: the device on one host and the rest
+on another (see the README's lab-network section).
 """
 
 from __future__ import annotations
@@ -157,7 +163,41 @@ def plan(params: dict[str, Any], params_file: Path, namespace: str) -> list[Node
     return out
 
 
-def launch(specs: list[NodeSpec], stop_timeout: float, duration: float | None) -> int:
+NETWORKS = {"localhost": "LOCALHOST", "subnet": "SUBNET"}
+
+
+def network_env(network: str, peers: Sequence[str]) -> dict[str, str]:
+    """The discovery variables for ``--network`` and ``--peers``."""
+    if network not in NETWORKS:
+        raise CliError(f"--network must be one of {', '.join(NETWORKS)}, got {network!r}")
+    env = {"ROS_AUTOMATIC_DISCOVERY_RANGE": NETWORKS[network]}
+    if peers:
+        if network == "localhost":
+            raise CliError("--peers needs --network subnet (peers are other hosts)")
+        env["ROS_STATIC_PEERS"] = ";".join(peers)
+    return env
+
+
+def select(specs: list[NodeSpec], only: Sequence[str]) -> list[NodeSpec]:
+    """The specs named in ``only`` (all when empty); unknown names are an error."""
+    if not only:
+        return specs
+    names = {s.name for s in specs}
+    unknown = [n for n in only if n not in names]
+    if unknown:
+        raise CliError(
+            f"--only names {', '.join(unknown)}, which the config does not start "
+            f"(it starts {', '.join(sorted(names))})"
+        )
+    return [s for s in specs if s.name in only]
+
+
+def launch(
+    specs: list[NodeSpec],
+    stop_timeout: float,
+    duration: float | None,
+    env: dict[str, str] | None = None,
+) -> int:
     """Start the processes, supervise them, forward signals, stop them all cleanly."""
     stop: list[int] = []
 
@@ -170,7 +210,9 @@ def launch(specs: list[NodeSpec], stop_timeout: float, duration: float | None) -
     try:
         for spec in specs:
             procs[spec.name] = subprocess.Popen(
-                [spec.executable, *spec.ros_args], start_new_session=True
+                [spec.executable, *spec.ros_args],
+                start_new_session=True,
+                env={**os.environ, **(env or {})},
             )
         t_end = None if duration is None else time.monotonic() + duration
         while not stop:
@@ -251,19 +293,24 @@ def command(
     stop_timeout: float,
     duration: float | None,
     executor: str | None,
+    only: Sequence[str] = (),
+    network: str = "localhost",
+    peers: Sequence[str] = (),
 ) -> int:
     """Resolve, plan and run; raises ``CliError`` on bad input."""
     import tempfile
 
     path = resolve_config(config)
     params = resolved_params(path, parse_sets(sets))
+    net = network_env(network, peers)
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
-        specs = plan(params, write_params_file(params, Path(tmp)), namespace)
+        specs = select(plan(params, write_params_file(params, Path(tmp)), namespace), only)
         if composed:
+            os.environ.update(net)
             return compose(specs, executor)
         if executor:
-            os.environ["HAPTIC_DOB_EXECUTOR"] = executor
-        return launch(specs, stop_timeout, duration)
+            net["HAPTIC_DOB_EXECUTOR"] = executor
+        return launch(specs, stop_timeout, duration, net)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -299,10 +346,39 @@ def main(argv: list[str] | None = None) -> int:
         choices=["events", "single"],
         help="rclpy executor of the nodes (default events)",
     )
+    p.add_argument(
+        "--only",
+        default="",
+        metavar="NODE[,NODE...]",
+        help="start only these nodes of the config (split a session across hosts)",
+    )
+    p.add_argument(
+        "--network",
+        choices=sorted(NETWORKS),
+        default="localhost",
+        help="discovery range of the nodes: localhost (default) or subnet (a lab network)",
+    )
+    p.add_argument(
+        "--peers",
+        default="",
+        metavar="HOST[,HOST...]",
+        help="other hosts to discover directly (ROS_STATIC_PEERS; needs --network subnet)",
+    )
     a = p.parse_args(argv)
+    only = [n for n in a.only.split(",") if n]
+    peers = [h for h in a.peers.split(",") if h]
     return run(
         lambda: command(
-            a.config, a.namespace, a.composed, a.set, a.stop_timeout, a.duration, a.executor
+            a.config,
+            a.namespace,
+            a.composed,
+            a.set,
+            a.stop_timeout,
+            a.duration,
+            a.executor,
+            only,
+            a.network,
+            peers,
         )
     )
 

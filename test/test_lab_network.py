@@ -1,0 +1,148 @@
+"""Two hosts on this machine: the device in one network namespace, the rest in another.
+
+The namespaces are joined by a veth pair (addresses inside 10.231.x only). The loop closes across
+them with ``--network subnet``; taking the link down makes the device's watchdog zero the force
+within ``command_timeout_s``; bringing it up resumes the loop. Needs root and ``ip`` (iproute2).
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rosgraph import Process, isolated_env
+
+pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
+
+BIN = Path(sys.executable).parent
+TIMEOUT_S, PERIOD_S = 0.005, 0.001
+
+
+def ip(*args: str) -> None:
+    subprocess.run(["ip", *args], check=True, capture_output=True, timeout=10)
+
+
+@pytest.fixture
+def hosts():
+    """Two network namespaces joined by a veth pair; yields (nsA, nsB, ifA)."""
+    if os.geteuid() != 0 or shutil.which("ip") is None:
+        pytest.skip("needs root and iproute2 to make network namespaces")
+    tag = f"{os.getpid() % 10000}{random.randint(0, 99)}"
+    a, b, va, vb = f"hapA{tag}", f"hapB{tag}", f"hva{tag}", f"hvb{tag}"
+    subnet = random.randint(1, 250)
+    try:
+        ip("netns", "add", a)
+        ip("netns", "add", b)
+        ip("link", "add", va, "type", "veth", "peer", "name", vb)
+        ip("link", "set", va, "netns", a)
+        ip("link", "set", vb, "netns", b)
+        ip("-n", a, "addr", "add", f"10.231.{subnet}.1/24", "dev", va)
+        ip("-n", b, "addr", "add", f"10.231.{subnet}.2/24", "dev", vb)
+        for ns, dev in ((a, va), (b, vb)):
+            ip("-n", ns, "link", "set", "lo", "up")
+            ip("-n", ns, "link", "set", dev, "up")
+        yield a, b, va
+    finally:
+        for ns in (a, b):
+            subprocess.run(["ip", "netns", "pids", ns], capture_output=True)
+            subprocess.run(["ip", "netns", "del", ns], capture_output=True)
+
+
+def in_ns(ns: str, argv: list[str], env: dict[str, str], log: Path) -> Process:
+    return Process(["ip", "netns", "exec", ns, *argv], env, log)
+
+
+def read(csv: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    rows = [r.split(",") for r in csv.read_text().splitlines() if r.count(",") == 2]
+    arr = np.array(rows, dtype=float)
+    return arr[:, 0], arr[:, 1] * 1e-9, arr[:, 2]
+
+
+def wait_live(csv: Path, since: float, timeout: float) -> bool:
+    """Wait until 300 samples after ``since`` carry a non-zero effort."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if csv.exists() and csv.stat().st_size:
+            t, _, e = read(csv)
+            if np.sum((t > since) & (np.abs(e) > 0.1)) > 300:
+                return True
+        time.sleep(0.3)
+    return False
+
+
+def test_loop_across_two_hosts_and_a_link_failure(hosts, root, tmp_path) -> None:
+    ns_a, ns_b, dev_a = hosts
+    env = isolated_env()
+    env.pop("ROS_AUTOMATIC_DISCOVERY_RANGE")
+    config = str(root / "config" / "slide_sim.yaml")
+    launch = str(BIN / "haptic-launch")
+    csv = tmp_path / "efforts.csv"
+    procs = [
+        in_ns(
+            ns_a,
+            [str(BIN / "python"), str(root / "test" / "netns_monitor.py"), str(csv)],
+            env,
+            tmp_path / "monitor.log",
+        ),
+        in_ns(
+            ns_b,
+            [
+                launch,
+                config,
+                "--network",
+                "subnet",
+                "--only",
+                "environment_node,observer_node,controller_node",
+            ],
+            env,
+            tmp_path / "b.log",
+        ),
+        in_ns(
+            ns_a,
+            [
+                launch,
+                config,
+                "--network",
+                "subnet",
+                "--only",
+                "device_node",
+                "--set",
+                "device_node:clock_mode=realtime",
+                "--set",
+                "device_node:duration_s=0.0",
+            ],
+            env,
+            tmp_path / "a.log",
+        ),
+    ]
+    try:
+        assert wait_live(csv, 0.0, 60), (tmp_path / "a.log").read_text()[-2000:]
+        t_down = time.monotonic()
+        ip("-n", ns_a, "link", "set", dev_a, "down")
+        time.sleep(1.5)
+        t_up = time.monotonic()
+        ip("-n", ns_a, "link", "set", dev_a, "up")
+        assert wait_live(csv, t_up, 60), "the loop did not resume after the link came back"
+        t, stamps, e = read(csv)
+        down = (t > t_down + 0.3) & (t < t_up)
+        assert down.sum() > 500 and np.all(e[down] == 0.0), "force not zero while the link is down"
+        # on the device's clock: the last command held until the watchdog zeroed it
+        window = (t > t_down - 0.5) & (t < t_up)
+        ew, sw = e[window], stamps[window]
+        last = np.nonzero(ew != 0.0)[0][-1]
+        held = 0
+        while held + 1 <= last and ew[last - held - 1] == ew[last]:
+            held += 1
+        latency = sw[last + 1] - sw[last - held]
+        assert latency <= TIMEOUT_S + 2 * PERIOD_S, f"{latency * 1e3:.1f} ms"
+    finally:
+        for p in reversed(procs):
+            p.stop()
