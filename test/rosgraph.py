@@ -214,8 +214,9 @@ def set_parameter(env: dict[str, str], node: str, name: str, value: Any, timeout
                 os.environ[k] = v
 
 
-def start_nodes(config: Path, env: dict[str, str], sets: Iterable[str], log_dir: Path,
-                namespace: str = "") -> dict[str, Process]:
+def start_nodes(
+    config: Path, env: dict[str, str], sets: Iterable[str], log_dir: Path, namespace: str = ""
+) -> dict[str, Process]:
     """Each node of ``config`` as its own process via ``<prefix>/lib/<pkg>/<exe>`` (no launcher,
     so a test can kill and restart single nodes)."""
     from haptic_dob.launcher import parse_sets, plan, resolved_params, write_params_file
@@ -224,18 +225,24 @@ def start_nodes(config: Path, env: dict[str, str], sets: Iterable[str], log_dir:
     params_file = write_params_file(params, log_dir)
     procs = {}
     for spec in plan(params, params_file, namespace):
-        procs[spec.name] = Process([spec.executable, *spec.ros_args], env,
-                                   log_dir / f"{spec.name}.log")
+        procs[spec.name] = Process(
+            [spec.executable, *spec.ros_args], env, log_dir / f"{spec.name}.log"
+        )
     return procs
 
 
-def restart(procs: dict[str, Process], name: str, env: dict[str, str], log_dir: Path,
-            config: Path, sets: Iterable[str]) -> None:
+def restart(
+    procs: dict[str, Process],
+    name: str,
+    env: dict[str, str],
+    log_dir: Path,
+    config: Path,
+    sets: Iterable[str],
+) -> None:
     """Start node ``name`` again with the same parameters."""
     from haptic_dob.launcher import parse_sets, plan, resolved_params, write_params_file
 
     params = resolved_params(config, parse_sets(list(sets)))
     params_file = write_params_file(params, log_dir)
     spec = next(s for s in plan(params, params_file, "") if s.name == name)
-    procs[name] = Process([spec.executable, *spec.ros_args], env,
-                          log_dir / f"{name}.restarted.log")
+    procs[name] = Process([spec.executable, *spec.ros_args], env, log_dir / f"{name}.restarted.log")

@@ -33,8 +33,11 @@ def efforts(col: Collector) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     with col._lock:
         raw = list(col.records[JOINT_STATES])
     msgs = [(t, decode(b)) for t, b in raw]
-    return (np.array([t for t, _ in msgs]), np.array([stamp_ns(m) * 1e-9 for _, m in msgs]),
-            np.array([m.effort[0] for _, m in msgs]))
+    return (
+        np.array([t for t, _ in msgs]),
+        np.array([stamp_ns(m) * 1e-9 for _, m in msgs]),
+        np.array([m.effort[0] for _, m in msgs]),
+    )
 
 
 def diagnostics_after(col: Collector, t0: float) -> list[str]:
@@ -55,14 +58,24 @@ def diagnostics_after(col: Collector, t0: float) -> list[str]:
         ("environment_node", "OL", "device_node: watchdog tripped"),
     ],
 )
-def test_kill_9_zeroes_the_force_within_the_command_timeout(root, tmp_path, victim, mode,
-                                                            reason) -> None:
+def test_kill_9_zeroes_the_force_within_the_command_timeout(
+    root, tmp_path, victim, mode, reason
+) -> None:
     env = isolated_env()
     config = root / "config" / "slide_sim.yaml"
-    sets = ["device_node:clock_mode=realtime", "device_node:duration_s=0.0",
-            f"controller_node:mode={mode}", "controller_node:kf=1.0"]
-    col = Collector(env, {JOINT_STATES: SESSION_TOPICS[JOINT_STATES],
-                          DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray"})
+    sets = [
+        "device_node:clock_mode=realtime",
+        "device_node:duration_s=0.0",
+        f"controller_node:mode={mode}",
+        "controller_node:kf=1.0",
+    ]
+    col = Collector(
+        env,
+        {
+            JOINT_STATES: SESSION_TOPICS[JOINT_STATES],
+            DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
+        },
+    )
     procs = start_nodes(config, env, sets, tmp_path)
     try:
         # the loop runs: the hand pushes into the wall, the effort is the wall's push-back

@@ -21,10 +21,15 @@ def test_realtime_loop_closes_at_rate(root, tmp_path, composed: bool) -> None:
     env = isolated_env()
     stats = tmp_path / "stats.json"
     graph = launch(
-        str(root / "config" / "slide_sim.yaml"), env,
-        ["device_node:clock_mode=realtime", "device_node:duration_s=3.0",
-         f"device_node:stats_file={stats}"],
-        tmp_path / "launch.log", extra=["--composed"] if composed else [],
+        str(root / "config" / "slide_sim.yaml"),
+        env,
+        [
+            "device_node:clock_mode=realtime",
+            "device_node:duration_s=3.0",
+            f"device_node:stats_file={stats}",
+        ],
+        tmp_path / "launch.log",
+        extra=["--composed"] if composed else [],
     )
     try:
         assert graph.wait(60) == 0, graph.output()

@@ -40,9 +40,13 @@ def _stub_modules(monkeypatch, launch_args: dict[str, str]) -> None:
     ros = types.ModuleType("launch_ros")
     ros_actions = types.ModuleType("launch_ros.actions")
     ros_actions.Node = _Recorder
-    for name, mod in {"launch": launch, "launch.actions": actions,
-                      "launch.substitutions": subs, "launch_ros": ros,
-                      "launch_ros.actions": ros_actions}.items():
+    for name, mod in {
+        "launch": launch,
+        "launch.actions": actions,
+        "launch.substitutions": subs,
+        "launch_ros": ros,
+        "launch_ros.actions": ros_actions,
+    }.items():
         monkeypatch.setitem(sys.modules, name, mod)
 
 

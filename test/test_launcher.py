@@ -15,8 +15,12 @@ from haptic_msgs_py.topics import JOINT_STATES, SESSION_TOPICS
 from haptic_sim.session import SessionConfig, run_session
 from rosgraph import Collector, isolated_env, launch
 
-NODE_EXES = ("haptic-device-node", "haptic-environment-node", "haptic-observer-node",
-             "haptic-controller-node")
+NODE_EXES = (
+    "haptic-device-node",
+    "haptic-environment-node",
+    "haptic-observer-node",
+    "haptic-controller-node",
+)
 
 
 def children_of(pid: int) -> list[int]:
@@ -39,10 +43,19 @@ def alive(pid: int) -> bool:
 def test_signal_to_the_launcher_stops_every_node_cleanly(root, tmp_path, sig) -> None:
     env = isolated_env()
     log = tmp_path / "launch.log"
+    out = open(log, "w")  # noqa: SIM115 - closed in finally, the launcher writes to it
     proc = subprocess.Popen(
-        [tool("haptic-launch"), str(root / "config" / "slide_sim.yaml"),
-         "--set", "device_node:clock_mode=realtime", "--set", "device_node:duration_s=0.0"],
-        env=env, stdout=open(log, "w"), stderr=subprocess.STDOUT,  # noqa: SIM115
+        [
+            tool("haptic-launch"),
+            str(root / "config" / "slide_sim.yaml"),
+            "--set",
+            "device_node:clock_mode=realtime",
+            "--set",
+            "device_node:duration_s=0.0",
+        ],
+        env=env,
+        stdout=out,
+        stderr=subprocess.STDOUT,
     )
     try:
         deadline = time.monotonic() + 30
@@ -63,6 +76,7 @@ def test_signal_to_the_launcher_stops_every_node_cleanly(root, tmp_path, sig) ->
             proc.kill()
         for pid in children_of(proc.pid):
             os.kill(pid, signal.SIGKILL)
+        out.close()
 
 
 @pytest.mark.multiprocess
@@ -71,10 +85,18 @@ def test_composed_graph_reproduces_the_batch_run(root, tmp_path) -> None:
     """All nodes in one process under one executor: the same trajectory as the batch run."""
     env = isolated_env()
     col = Collector(env, {JOINT_STATES: SESSION_TOPICS[JOINT_STATES]})
-    graph = launch(str(root / "config" / "slide_sim.yaml"), env,
-                   ["device_node:wait_for=[environment_node, observer_node, controller_node, "
-                    "collector]", "device_node:duration_s=2.0", "controller_node:mode=DOB",
-                    "controller_node:kf=1.0"], tmp_path / "launch.log", extra=["--composed"])
+    graph = launch(
+        str(root / "config" / "slide_sim.yaml"),
+        env,
+        [
+            "device_node:wait_for=[environment_node, observer_node, controller_node, collector]",
+            "device_node:duration_s=2.0",
+            "controller_node:mode=DOB",
+            "controller_node:kf=1.0",
+        ],
+        tmp_path / "launch.log",
+        extra=["--composed"],
+    )
     try:
         assert graph.wait(120) == 0, graph.output()
         assert col.wait_for(JOINT_STATES, 2001, 10)
@@ -89,8 +111,13 @@ def test_composed_graph_reproduces_the_batch_run(root, tmp_path) -> None:
 
 
 def launch_cli(*args: str, env=None) -> subprocess.CompletedProcess:
-    return subprocess.run([tool("haptic-launch"), *args], capture_output=True, text=True,
-                          timeout=60, env=env or isolated_env())
+    return subprocess.run(
+        [tool("haptic-launch"), *args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env or isolated_env(),
+    )
 
 
 @pytest.mark.parametrize(
@@ -125,4 +152,5 @@ def test_config_errors_are_reported(tmp_path) -> None:
 def test_a_refused_node_parameter_stops_the_graph_with_its_reason(root, tmp_path) -> None:
     out = launch_cli(str(root / "config" / "slide_sim.yaml"), "--set", "controller_node:kf=-3")
     assert out.returncode == 1
-    assert "parameter kf refused" in out.stderr and "controller_node exited with code 2" in out.stderr
+    assert "parameter kf refused" in out.stderr
+    assert "controller_node exited with code 2" in out.stderr

@@ -25,8 +25,9 @@ from haptic_msgs_py.stamps import command_label
 from haptic_sim.nodes.device_node import DeviceNode
 from rosgraph import isolated_env
 
-SETTINGS = settings(max_examples=150, deadline=None,
-                    suppress_health_check=[HealthCheck.function_scoped_fixture])
+SETTINGS = settings(
+    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 
 
 @pytest.fixture(scope="module")
@@ -90,10 +91,11 @@ def test_watchdog_zeroes_the_effort_and_the_next_command_resumes(context) -> Non
         assert dev.device.sample().effort == (1.5,) and not dev.watchdog_tripped
         dev._tick(10.0 + timeout * 1.1)  # silence beyond the timeout
         assert dev.device.sample().effort == (0.0,) and dev.watchdog_tripped
-        level, message, values = dev._report()
+        _level, message, values = dev._report()
         assert "watchdog tripped" in message and values["watchdog"].startswith("tripped")
-        dev._on_command(wire.float64_multi_array(command_label(dev.device.k * dev.period_ns),
-                                                 [-1.0]))
+        dev._on_command(
+            wire.float64_multi_array(command_label(dev.device.k * dev.period_ns), [-1.0])
+        )
         import time
 
         dev._tick(time.monotonic())
@@ -117,7 +119,7 @@ def test_effort_limits_are_checked_against_the_actuator(context) -> None:
 # --- parameter fuzz ------------------------------------------------------------------------
 any_value = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
-    st.integers(min_value=-10**6, max_value=10**6),
+    st.integers(min_value=-(10**6), max_value=10**6),
     st.text(max_size=12),
     st.booleans(),
     st.lists(st.floats(allow_nan=True, allow_infinity=True), max_size=4),
@@ -130,21 +132,28 @@ def fingerprint(node) -> tuple:
     """What the node's behaviour depends on, for checking that a refusal changed nothing."""
     table = dict(node.params.values)
     if isinstance(node, ControllerNode):
-        return (table, node.controller.law, node.controller.command(
-            [0.0], (-1.0, 0.0, 0.0), (0.5, 0.0, 0.0), (0.8, 0.0, 0.0)))
+        return (
+            table,
+            node.controller.law,
+            node.controller.command([0.0], (-1.0, 0.0, 0.0), (0.5, 0.0, 0.0), (0.8, 0.0, 0.0)),
+        )
     if isinstance(node, EnvironmentNode):
         return (table, node.wall, node.wall.force((0.001, 0, 0), (0.1, 0, 0)))
     if isinstance(node, ObserverNode):
-        return (table, node.observer.gain, None if node.observer.limit is None
-                else tuple(node.observer.limit))
+        return (
+            table,
+            node.observer.gain,
+            None if node.observer.limit is None else tuple(node.observer.limit),
+        )
     return (table, node.limits)
 
 
-@pytest.mark.parametrize("cls", [ControllerNode, EnvironmentNode, ObserverNode, DeviceNode],
-                         ids=lambda c: c.__name__)
+@pytest.mark.parametrize(
+    "cls", [ControllerNode, EnvironmentNode, ObserverNode, DeviceNode], ids=lambda c: c.__name__
+)
 def test_parameter_fuzz_refusals_change_nothing(context, cls) -> None:
     node = cls(context=context)
-    names = sorted(node.params.specs) + ["no_such_parameter"]
+    names = [*sorted(node.params.specs), "no_such_parameter"]
 
     @given(name=st.sampled_from(names), value=any_value)
     @SETTINGS
