@@ -77,40 +77,44 @@ class _Input:
         return len(r) == WARM_SAMPLES and r[0] >= newest - WARM_WINDOW * period_ns
 
 
+def controller_node_specs() -> list[ParamSpec]:
+    """Every parameter of the controller node."""
+    return [
+        *loop_specs(),
+        *model_specs(),
+        *specs_of(ImpedanceLaw),
+        ParamSpec(
+            "input_warn_s",
+            2.0,
+            "warn when an input of a pending cycle is this late",
+            "s",
+            0.01,
+            3600.0,
+        ),
+        ParamSpec(
+            "fallback",
+            "zero",
+            "what to render when the mode's force input stops: zero force or OL",
+            choices=("zero", "OL"),
+        ),
+        ParamSpec(
+            "input_timeout_s",
+            0.02,
+            "the mode's force input counts as stopped after this long (wall time for a waiting "
+            "cycle, stamp time for its newest sample)",
+            "s",
+            0.001,
+            10.0,
+        ),
+    ]
+
+
 class ControllerNode(LoopNode):
     """Computes command k from the stamp-k inputs its mode needs."""
 
     def __init__(self, context: Context | None = None, name: str = "controller_node") -> None:
         super().__init__(name, context=context)
-        specs = [
-            *loop_specs(),
-            *model_specs(),
-            *specs_of(ImpedanceLaw),
-            ParamSpec(
-                "input_warn_s",
-                2.0,
-                "warn when an input of a pending cycle is this late",
-                "s",
-                0.01,
-                3600.0,
-            ),
-            ParamSpec(
-                "fallback",
-                "zero",
-                "what to render when the mode's force input stops: zero force or OL",
-                choices=("zero", "OL"),
-            ),
-            ParamSpec(
-                "input_timeout_s",
-                0.02,
-                "the mode's force input counts as stopped after this long (wall time for a waiting "
-                "cycle, stamp time for its newest sample)",
-                "s",
-                0.001,
-                10.0,
-            ),
-        ]
-        self.params = ParameterTable(self, specs, self._settings, self._apply)
+        self.params = ParameterTable(self, controller_node_specs(), self._settings, self._apply)
         values = self.params.values
         self.model = build_model(values)
         self.period_ns = round(1e9 / values["rate_hz"])

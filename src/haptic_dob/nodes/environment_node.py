@@ -12,7 +12,7 @@ from haptic_dob.environment import VirtualWall
 from haptic_dob.nodes.common import loop_specs, main_for
 from haptic_msgs_py import wire
 from haptic_msgs_py.convert import read_linear, read_position, write_force
-from haptic_msgs_py.params import build, specs_of
+from haptic_msgs_py.params import ParamSpec, build, specs_of
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_msgs_py.ros.params import ParameterTable
@@ -21,14 +21,17 @@ from haptic_msgs_py.ros.spin import LoopNode
 from haptic_msgs_py.topics import EE_POSE, EE_TWIST, SESSION_TOPICS, WRENCH_DESIRED
 
 
+def environment_node_specs() -> list[ParamSpec]:
+    """Every parameter of the environment node (the wall's change at run time)."""
+    return [*loop_specs(), *specs_of(VirtualWall)]
+
+
 class EnvironmentNode(LoopNode):
     """Renders a unilateral wall; its stiffness, damping, position and normal change at run time."""
 
     def __init__(self, context: Context | None = None, name: str = "environment_node") -> None:
         super().__init__(name, context=context)
-        self.params = ParameterTable(
-            self, [*loop_specs(), *specs_of(VirtualWall)], self._settings, self._apply
-        )
+        self.params = ParameterTable(self, environment_node_specs(), self._settings, self._apply)
         self.wall: VirtualWall = self.params.settings
         self._pose: Any = None
         self._twist: Any = None

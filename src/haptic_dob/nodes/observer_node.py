@@ -23,7 +23,7 @@ from haptic_dob.nodes.common import loop_specs, main_for
 from haptic_dob.observer import DisturbanceObserver, ObserverSettings
 from haptic_msgs_py import wire
 from haptic_msgs_py.convert import write_force
-from haptic_msgs_py.params import build, specs_of
+from haptic_msgs_py.params import ParamSpec, build, specs_of
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.diagnostics import ERROR, OK, WARN, Diagnostics, Report
 from haptic_msgs_py.ros.params import ParameterTable
@@ -72,13 +72,17 @@ def pick(values: Any, index: list[int], what: str, n_names: int) -> list[float]:
     return [float(seq[i]) for i in index]
 
 
+def observer_node_specs() -> list[ParamSpec]:
+    """Every parameter of the observer node."""
+    return [*loop_specs(), *model_specs(), *specs_of(ObserverSettings)]
+
+
 class ObserverNode(LoopNode):
     """Publishes the estimated contact wrench and external joint effort of any device model."""
 
     def __init__(self, context: Context | None = None, name: str = "observer_node") -> None:
         super().__init__(name, context=context)
-        specs = [*loop_specs(), *model_specs(), *specs_of(ObserverSettings)]
-        self.params = ParameterTable(self, specs, self._settings, self._apply)
+        self.params = ParameterTable(self, observer_node_specs(), self._settings, self._apply)
         values = self.params.values
         self.model: DeviceModel = build_model(values)
         self.period_ns = round(1e9 / values["rate_hz"])
