@@ -1,4 +1,4 @@
-"""Write docs/parameters.md from the nodes' parameter tables (``make docs``; a test keeps it current).
+"""Write docs/parameters.md from the nodes' parameter tables (a test keeps it current).
 
 Usage: ``.venv/bin/python scripts/param_docs.py [--check]``
 """
@@ -53,9 +53,14 @@ def render() -> str:
         "",
     ]
     for node, run, specs in tables():
-        lines += [f"## {node}", "", f"`ros2 run {run}`", "",
-                  "| parameter | default | unit | range / choices | run time | description |",
-                  "|---|---|---|---|---|---|"]
+        lines += [
+            f"## {node}",
+            "",
+            f"`ros2 run {run}`",
+            "",
+            "| parameter | default | unit | range / choices | run time | description |",
+            "|---|---|---|---|---|---|",
+        ]
         for s in specs:
             default = repr(s.default) if isinstance(s.default, str) else s.default
             lines.append(
