@@ -1,12 +1,19 @@
-"""Build a simulated device from parameters: the device node and batch runs share it."""
+"""Build a simulated device from parameters: the device node and batch runs share it.
+
+``model: slide`` builds the ``SimulatedSlide`` (groups ``slide.``, ``plant.``); ``model: phantom``
+or ``urdf`` a ``SimulatedArm`` of the model ``build_model`` names (groups ``phantom.`` or the URDF
+parameters, and ``arm.``). ``sensor.`` and ``hand.`` serve both.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from typing import Any
 
+from haptic_dob.models.factory import build_model
 from haptic_dob.models.slide import SlideParams
 from haptic_msgs_py.params import ParamSpec, build, specs_of
+from haptic_sim.arm import ArmDeviceParams, SimulatedArm
 from haptic_sim.hand import HandParams
 from haptic_sim.sensor import ForceSensorParams
 from haptic_sim.session import LoopSettings
@@ -18,23 +25,34 @@ def simulation_specs() -> list[ParamSpec]:
     return [
         *(s for s in specs_of(LoopSettings, read_only=True) if s.name != "rate_hz"),
         *specs_of(SlideDeviceParams, "plant.", read_only=True),
+        *specs_of(ArmDeviceParams, "arm.", read_only=True),
         *specs_of(ForceSensorParams, "sensor.", read_only=True),
         *specs_of(HandParams, "hand.", read_only=True),
     ]
 
 
-def build_device(values: Mapping[str, Any]) -> SimulatedSlide:
-    """The simulated device the parameters describe (``model``: slide)."""
+def build_device(values: Mapping[str, Any]) -> SimulatedSlide | SimulatedArm:
+    """The simulated device the parameters describe (``model``: slide, phantom or urdf)."""
     kind = values.get("model", "slide")
-    if kind != "slide":
-        raise ValueError(f"device_node simulates model slide, got {kind!r}")
     loop = build(LoopSettings, values)
-    return SimulatedSlide(
-        build(SlideParams, values, "slide."),
-        build(SlideDeviceParams, values, "plant."),
-        build(ForceSensorParams, values, "sensor."),
-        build(HandParams, values, "hand."),
-        loop.rate_hz,
-        loop.substeps,
-        loop.seed,
-    )
+    if kind == "slide":
+        return SimulatedSlide(
+            build(SlideParams, values, "slide."),
+            build(SlideDeviceParams, values, "plant."),
+            build(ForceSensorParams, values, "sensor."),
+            build(HandParams, values, "hand."),
+            loop.rate_hz,
+            loop.substeps,
+            loop.seed,
+        )
+    if kind in ("phantom", "urdf"):
+        return SimulatedArm(
+            build_model(values),
+            build(ArmDeviceParams, values, "arm."),
+            build(ForceSensorParams, values, "sensor."),
+            build(HandParams, values, "hand."),
+            loop.rate_hz,
+            loop.substeps,
+            loop.seed,
+        )
+    raise ValueError(f"device_node simulates model slide, phantom or urdf, got {kind!r}")

@@ -1,4 +1,13 @@
-"""Build the device model a node or a batch run names by parameters (``model`` + its group)."""
+"""Build the device model a node or a batch run names by parameters (``model`` + its group).
+
+- ``slide``: ``slide.*`` (``SlideParams``).
+- ``phantom``: ``phantom.params`` (``appendix_b`` | ``cavusoglu``), ``phantom.gravity``,
+  ``phantom.viscous_n_m_s_per_rad`` (``PhantomSettings``).
+- ``urdf``: ``robot_description`` (URDF text, the ROS convention) or ``urdf_path``, ``tip_frame``,
+  ``joint_names``, plus ``urdf.gravity`` and ``urdf.viscous_n_m_s_per_rad``.
+
+All of them are structural, so read-only.
+"""
 
 from __future__ import annotations
 
@@ -6,10 +15,12 @@ from collections.abc import Mapping
 from typing import Any
 
 from haptic_dob.models.base import DeviceModel
+from haptic_dob.models.phantom import PhantomSettings
 from haptic_dob.models.slide import SlideParams
+from haptic_dob.models.urdf import UrdfOptions, UrdfSettings
 from haptic_msgs_py.params import ParamSpec, build, specs_of
 
-MODEL_KINDS = ("slide",)
+MODEL_KINDS = ("slide", "phantom", "urdf")
 
 
 def model_specs() -> list[ParamSpec]:
@@ -17,12 +28,22 @@ def model_specs() -> list[ParamSpec]:
     return [
         ParamSpec("model", "slide", "device model", choices=MODEL_KINDS, read_only=True),
         *specs_of(SlideParams, "slide.", read_only=True),
+        *specs_of(PhantomSettings, "phantom.", read_only=True),
+        *specs_of(UrdfSettings, "", read_only=True),
+        *specs_of(UrdfOptions, "urdf.", read_only=True),
     ]
 
 
 def build_model(values: Mapping[str, Any]) -> DeviceModel:
-    """The model named by ``values['model']`` with its group's settings (``slide.*``)."""
+    """The model named by ``values['model']`` with its group's settings.
+
+    Raises ``ValueError`` with one clear message when the settings are missing or invalid.
+    """
     kind = values.get("model", "slide")
     if kind == "slide":
         return build(SlideParams, values, "slide.").model()
+    if kind == "phantom":
+        return build(PhantomSettings, values, "phantom.").model()
+    if kind == "urdf":
+        return build(UrdfSettings, values).model(build(UrdfOptions, values, "urdf."))
     raise ValueError(f"model must be one of {', '.join(MODEL_KINDS)}, got {kind!r}")

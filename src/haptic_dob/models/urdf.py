@@ -1,0 +1,108 @@
+"""Any serial arm from a URDF, computed with pinocchio (sensorless tip-force estimation).
+
+The joint-space vectors follow ``joint_names`` (default: the joints that move ``tip_frame``, from
+the root out); every other joint of the URDF is locked at zero. The end-effector point is the
+origin of ``tip_frame``; its Jacobian is the linear part of the frame Jacobian in the base frame's
+axes (pinocchio's ``LOCAL_WORLD_ALIGNED``). Gravity is 9.81 m/s^2 along -z of the URDF's root.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from haptic_dob.models._pinocchio import PinocchioModel, urdf_model
+from haptic_msgs_py.params import param
+
+
+class UrdfModel(PinocchioModel):
+    """A serial arm from a URDF file or XML string (``DeviceModel``).
+
+    Args:
+        urdf: URDF XML text (e.g. a ``robot_description``) or the path of a ``.urdf`` file.
+        tip_frame: the link or frame whose origin is the end-effector point.
+        joint_names: the joints to use, in this order (default: the chain to ``tip_frame``).
+        gravity: False leaves gravity out of the model.
+        viscous: viscous joint friction (N m s/rad or N s/m), scalar or per joint, default 0.
+
+    Raises ``ValueError`` with a clear message for a bad URDF, an unknown frame or joint, or a
+    joint that is not a 1-DOF revolute or prismatic joint.
+    """
+
+    def __init__(
+        self,
+        urdf: str | Path,
+        tip_frame: str,
+        joint_names: Sequence[str] | None = None,
+        *,
+        gravity: bool = True,
+        viscous: float | Sequence[float] = 0.0,
+    ) -> None:
+        if not str(tip_frame):
+            raise ValueError("tip_frame must name a frame of the URDF, got ''")
+        arm = urdf_model(urdf, str(tip_frame), joint_names)
+        self.tip_frame = str(tip_frame)
+        #: per-joint effort limits from the URDF's <limit effort=...> (0 where none)
+        self.effort_limits = arm.effort_limits
+        super().__init__(
+            arm.model, arm.frame_id, arm.joint_names, arm.S, gravity=gravity, viscous=viscous
+        )
+
+    def __repr__(self) -> str:
+        return (
+            f"UrdfModel(tip_frame={self.tip_frame!r}, joint_names={list(self.joint_names)}, "
+            f"gravity={self.gravity_enabled})"
+        )
+
+
+@dataclass(frozen=True)
+class UrdfSettings:
+    """URDF model settings a node takes (ROS conventions: ``robot_description``, ...).
+
+    ``robot_description`` (URDF text) wins over ``urdf_path``; ``joint_names`` empty (or ``['']``)
+    means the chain to ``tip_frame``.
+    """
+
+    robot_description: str = field(
+        default="", metadata=param("URDF XML of the arm (model: urdf); wins over urdf_path")
+    )
+    urdf_path: str = field(default="", metadata=param("path of the arm's URDF file (model: urdf)"))
+    tip_frame: str = field(
+        default="", metadata=param("URDF frame whose origin is the end-effector point")
+    )
+    # a list default: a tuple default would fix the array's length in the parameter table
+    joint_names: list[str] | tuple[str, ...] = field(
+        default_factory=lambda: [""],
+        metadata=param("joints used, in order; [''] = the chain from the root to tip_frame"),
+    )
+
+    def model(self, options: UrdfOptions | None = None) -> UrdfModel:
+        """The ``UrdfModel`` these settings name (``ValueError`` when incomplete or invalid)."""
+        opts = options or UrdfOptions()
+        source = self.robot_description or self.urdf_path
+        if not source:
+            raise ValueError("model urdf needs robot_description (URDF text) or urdf_path")
+        if not self.tip_frame:
+            raise ValueError("model urdf needs tip_frame (the end-effector frame)")
+        names = [n for n in self.joint_names if n]
+        return UrdfModel(
+            source,
+            self.tip_frame,
+            names or None,
+            gravity=opts.gravity,
+            viscous=opts.viscous_n_m_s_per_rad,
+        )
+
+
+@dataclass(frozen=True)
+class UrdfOptions:
+    """Dynamics options of a URDF model (parameter group ``urdf.``)."""
+
+    gravity: bool = field(
+        default=True,
+        metadata=param("include gravity in the model (false: an observer that leaves G out)"),
+    )
+    viscous_n_m_s_per_rad: float = field(
+        default=0.0, metadata=param("viscous joint friction", "N m s/rad", 0.0, 1e3)
+    )

@@ -1,0 +1,243 @@
+"""The multi-DOF batch runner: one simulated arm session in-process, node-graph cycle timing.
+
+Per cycle k, in the order the node graph runs them (as ``session.py`` does for the slide):
+
+1. the device reports sample k (``SimulatedArm.sample``);
+2. the environment computes the wall force from the end-effector pose and twist of sample k;
+3. the observer updates with sample k (positions, velocities, effort applied over [k-1, k));
+4. the controller computes command k from the stamp-k inputs its mode needs;
+5. the device holds command k over [k, k+1) and steps to k+1.
+
+``exact_force=True`` replaces the observer's wrench at the controller's DOB input by the exact
+one (thesis section 5.2.2's comparison): the disturbance the observer would see without lag,
+``d = J^T F_tip + h_obs(q, q') - h_plant(q, q')`` at the sample's true state (``h`` = Coriolis,
+gravity and friction of the observer's and of the true model; the inertias are assumed equal),
+mapped to the tip with the observer's own damped least squares. With an observer model that
+leaves gravity out this is the true tip force plus gravity's equivalent tip force.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from haptic_dob.control import ImpedanceController, ImpedanceLaw
+from haptic_dob.environment import VirtualWall
+from haptic_dob.models.base import DeviceModel
+from haptic_dob.models.factory import build_model
+from haptic_dob.models.phantom import PhantomModel
+from haptic_dob.observer import ObserverSettings, dls_transpose_solve
+from haptic_msgs_py.params import build
+from haptic_sim.arm import ArmDeviceParams, SimulatedArm
+from haptic_sim.hand import HandParams
+from haptic_sim.sensor import ForceSensorParams
+from haptic_sim.session import LoopSettings, _flatten
+
+
+@dataclass(frozen=True)
+class ArmSessionConfig:
+    """Everything a simulated arm session needs.
+
+    ``plant`` is the true physics; ``observer_model`` the observer's (and controller's) model,
+    default the plant itself (a perfect model). ``wall`` with zero stiffness renders nothing.
+    """
+
+    loop: LoopSettings = field(default_factory=lambda: LoopSettings(duration_s=2.0))
+    plant: DeviceModel = field(default_factory=PhantomModel)
+    device: ArmDeviceParams = field(default_factory=ArmDeviceParams)
+    sensor: ForceSensorParams = field(default_factory=ForceSensorParams)
+    hand: HandParams = field(default_factory=lambda: HandParams(behaviour="none"))
+    wall: VirtualWall = field(default_factory=lambda: VirtualWall(stiffness_n_per_m=0.0))
+    law: ImpedanceLaw = field(default_factory=lambda: ImpedanceLaw(max_force_n=8.5))
+    observer: ObserverSettings = field(
+        default_factory=lambda: ObserverSettings(gain=2.0, output_limit=0.0)
+    )
+    observer_model: DeviceModel | None = None
+    exact_force: bool = False
+    hold_s: float = 0.0
+
+    def replace(self, **groups: Any) -> ArmSessionConfig:
+        """A copy with whole groups replaced, or single fields as ``group__field=value``."""
+        direct = {k: v for k, v in groups.items() if "__" not in k}
+        cfg = dataclasses.replace(self, **direct)
+        for key, value in groups.items():
+            if "__" in key:
+                g, f = key.split("__", 1)
+                cfg = dataclasses.replace(
+                    cfg, **{g: dataclasses.replace(getattr(cfg, g), **{f: value})}
+                )
+        return cfg
+
+    @classmethod
+    def from_node_params(cls, nodes: Mapping[str, Mapping[str, Any]]) -> ArmSessionConfig:
+        """Build from per-node parameter dicts (``device_node``, ``observer_node``...; ``/**``)."""
+        common = dict(nodes.get("/**", {}))
+
+        def of(name: str) -> dict[str, Any]:
+            return {**common, **dict(nodes.get(name, {}))}
+
+        dev, env, obs, ctl = (
+            of("device_node"),
+            of("environment_node"),
+            of("observer_node"),
+            of("controller_node"),
+        )
+        if dev.get("model", "slide") == "slide":
+            raise ValueError("an arm session needs model phantom or urdf, got slide")
+        return cls(
+            loop=build(LoopSettings, dev),
+            plant=build_model(dev),
+            device=build(ArmDeviceParams, dev, "arm."),
+            sensor=build(ForceSensorParams, dev, "sensor."),
+            hand=build(HandParams, dev, "hand."),
+            wall=build(VirtualWall, env),
+            law=build(ImpedanceLaw, ctl),
+            observer=build(ObserverSettings, obs),
+            observer_model=build_model(obs),
+        )
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> ArmSessionConfig:
+        """Load a ``ros__parameters`` YAML file (the one the node graph is launched with)."""
+        import yaml
+
+        with open(path, encoding="utf-8") as fh:
+            doc = yaml.safe_load(fh) or {}
+        if not isinstance(doc, dict):
+            raise ValueError(f"{path}: expected a mapping of node names to ros__parameters")
+        nodes = {}
+        for name, body in doc.items():
+            params = (body or {}).get("ros__parameters", {}) if isinstance(body, dict) else {}
+            nodes[str(name).rsplit("/", 1)[-1] if name != "/**" else "/**"] = _flatten(params)
+        return cls.from_node_params(nodes)
+
+
+@dataclass
+class ArmSessionResult:
+    """Per-cycle arrays of an arm session (SI units), one row per cycle k.
+
+    Joint arrays are (N, dof), Cartesian ones (N, 3): ``q_true``/``ee_true`` the true state at
+    sample k, ``q``/``qd``/``ee`` what the device reported, ``effort`` the effort applied over
+    [k-1, k), ``command`` command k, ``tip_force`` the true external force on the end effector
+    (hand + external), ``d_hat`` the observer's joint estimate and ``d_exact`` the exact
+    disturbance of the observer's model, ``force_estimated`` the observer's wrench and
+    ``force_used`` what the controller's DOB input got.
+    """
+
+    config: ArmSessionConfig
+    t: np.ndarray
+    q_true: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    effort: np.ndarray
+    command: np.ndarray
+    ee_true: np.ndarray
+    ee: np.ndarray
+    wall_force: np.ndarray
+    tip_force: np.ndarray
+    force_measured: np.ndarray
+    force_estimated: np.ndarray
+    force_used: np.ndarray
+    d_hat: np.ndarray
+    d_exact: np.ndarray
+
+    def save(self, path: str | Path) -> None:
+        """Write the arrays to an ``.npz`` file."""
+        arrays = {
+            f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "config"
+        }
+        np.savez(path, **arrays)
+
+
+def exact_disturbance(device: SimulatedArm, observer_model: DeviceModel) -> np.ndarray:
+    """The joint disturbance the observer's model sees at the device's true state (see top)."""
+    q, v = device.q, device.v
+    plant = device.model
+    d = observer_model._bias_effort(q, v) - plant._bias_effort(q, v)
+    if np.any(device.tip_force_true != 0.0):
+        d = d + plant._jacobian(q).T @ device.tip_force_true
+    return d
+
+
+def run_arm_session(config: ArmSessionConfig, cycles: int | None = None) -> ArmSessionResult:
+    """Run ``config`` in-process for ``cycles`` cycles (default: duration_s * rate_hz)."""
+    loop = config.loop
+    device = SimulatedArm(
+        config.plant,
+        config.device,
+        config.sensor,
+        config.hand,
+        loop.rate_hz,
+        loop.substeps,
+        loop.seed,
+    )
+    n = round(loop.duration_s * loop.rate_hz) if cycles is None else int(cycles)
+    if n <= 0:
+        raise ValueError(f"a batch session needs at least one cycle, got {n}")
+    obs_model = config.observer_model or config.plant
+    if obs_model.dof != device.dof:
+        raise ValueError(f"observer model has {obs_model.dof} joints, the plant {device.dof}")
+    observer = config.observer.build(obs_model, device.dt)
+    controller = ImpedanceController(obs_model, config.law)
+    wall = config.wall
+    dof = device.dof
+    # warm-up: the device held at rest (its actuators balance the true gravity) while the
+    # observer converges; the record starts at the release
+    for _ in range(round(config.hold_s * loop.rate_hz)):
+        s = device.sample()
+        observer.update(s.q, s.qd, s.effort)
+        device.apply(config.plant._gravity(device.q).tolist())
+    joint = {k: np.empty((n, dof)) for k in ("q_true", "q", "qd", "effort", "command")}
+    joint |= {k: np.empty((n, dof)) for k in ("d_hat", "d_exact")}
+    cart = {
+        k: np.empty((n, 3))
+        for k in (
+            "ee_true",
+            "ee",
+            "wall_force",
+            "tip_force",
+            "force_measured",
+            "force_estimated",
+            "force_used",
+        )
+    }
+    for k in range(n):
+        s = device.sample()
+        joint["q_true"][k] = device.q
+        cart["ee_true"][k] = obs_model._forward_kinematics(device.q)
+        d_exact = exact_disturbance(device, obs_model)
+        f_wall = wall.force(s.ee_position, s.ee_velocity)
+        d_hat = observer.update(s.q, s.qd, s.effort)
+        fe = observer.wrench(s.q)
+        f_est = (float(fe[0]), float(fe[1]), float(fe[2]))
+        if config.exact_force:
+            fx = dls_transpose_solve(
+                obs_model._jacobian(device.q),
+                d_exact,
+                observer.dls_threshold_m,
+                observer.dls_damping_m,
+            )
+            f_used = (float(fx[0]), float(fx[1]), float(fx[2]))
+        else:
+            f_used = f_est
+        tau = controller.command(s.q, f_wall, s.wrench_measured, f_used)
+        device.apply(tau)
+        joint["q"][k] = s.q
+        joint["qd"][k] = s.qd
+        joint["effort"][k] = s.effort
+        joint["command"][k] = tau
+        joint["d_hat"][k] = d_hat
+        joint["d_exact"][k] = d_exact
+        cart["ee"][k] = s.ee_position
+        cart["wall_force"][k] = f_wall
+        cart["tip_force"][k] = s.hand_force
+        cart["force_measured"][k] = s.wrench_measured
+        cart["force_estimated"][k] = f_est
+        cart["force_used"][k] = f_used
+    t = np.arange(n) * device.dt
+    return ArmSessionResult(config=config, t=t, **joint, **cart)
