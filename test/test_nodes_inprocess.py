@@ -145,3 +145,29 @@ def test_bad_start_values_fail_the_node_with_the_reason() -> None:
             ControllerNode(context=ctx)
     finally:
         rclpy.try_shutdown(context=ctx)
+
+
+def test_device_holds_the_loop_while_a_recorder_lags(context) -> None:
+    """Lockstep back-pressure: a command is held until the recorder's progress catches up."""
+    from haptic_msgs_py import wire
+    from haptic_msgs_py.stamps import command_label
+
+    dev = DeviceNode(context=context)
+    try:
+        dev._started = True
+        period = dev.period_ns
+        for k in range(600):  # 0.6 s of simulated time, no recorder yet: the loop runs freely
+            dev._on_command(wire.float64_multi_array(command_label(k * period), [0.0]))
+        assert dev.device.k == 600
+        progress = wire.clock()
+        progress.clock = wire.Time(sec=0, nanosec=50_000_000)  # the recorder has written 0.05 s
+        dev._on_progress(progress)
+        dev._on_command(wire.float64_multi_array(command_label(600 * period), [0.0]))
+        assert dev.device.k == 600 and dev._held is not None  # 0.55 s behind > 0.5 s: held
+        progress.clock = wire.Time(sec=0, nanosec=400_000_000)
+        dev._on_progress(progress)  # caught up to 0.2 s behind: released
+        assert dev.device.k == 601 and dev._held is None
+        res = dev.set_parameters([Parameter("max_recorder_lag_s", value=0.0)])[0]
+        assert not res.successful
+    finally:
+        dev.destroy_node()

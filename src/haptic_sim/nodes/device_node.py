@@ -121,6 +121,14 @@ def device_node_specs() -> list[ParamSpec]:
             "realtime: write cycle statistics (JSON) here at shutdown",
             read_only=True,
         ),
+        ParamSpec(
+            "max_recorder_lag_s",
+            0.5,
+            "lockstep: hold the loop while a recorder is this far behind in simulated time",
+            "s",
+            0.01,
+            3600.0,
+        ),
     ]
 
 
