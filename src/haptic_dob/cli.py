@@ -39,6 +39,9 @@ def run(fn: Callable[[], int | None]) -> int:
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:  # the reader went away (``| head``): stop quietly
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - nothing more may reach the pipe
+        return EXIT_OK
     except (CliError, ValueError, OSError) as exc:
         print(f"ERROR: {_one_line(exc)}", file=sys.stderr)
         return EXIT_ERROR

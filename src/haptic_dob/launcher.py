@@ -32,6 +32,7 @@ import yaml
 
 from haptic_dob.cli import ArgumentParser, CliError, run
 from haptic_dob.configs import resolve_config
+from haptic_msgs_py.params import load_node_params
 
 #: node name -> (package, executable, import path of the node class for --composed)
 NODES: dict[str, tuple[str, str, str]] = {
@@ -103,19 +104,7 @@ def parse_sets(items: Sequence[str]) -> dict[str, dict[str, Any]]:
 
 def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """The config's node sections (flattened, ``--set`` applied), keyed by node name."""
-    try:
-        doc = yaml.safe_load(config.read_text(encoding="utf-8")) or {}
-    except yaml.YAMLError as exc:
-        raise CliError(f"{config} is not valid YAML: {' '.join(str(exc).split())}") from None
-    if not isinstance(doc, dict):
-        raise CliError(f"{config} must map node names to ros__parameters")
-    out: dict[str, Any] = {}
-    for key, body in doc.items():
-        name = "/**" if key == "/**" else str(key).rsplit("/", 1)[-1]
-        params = (body or {}).get("ros__parameters") if isinstance(body, dict) else None
-        if not isinstance(params, dict):
-            raise CliError(f"{config}: section {key!r} has no ros__parameters mapping")
-        out[name] = _flatten(params)
+    out = load_node_params(config)
     unknown = [n for n in out if n != "/**" and n not in NODES]
     if unknown:
         raise CliError(
@@ -123,16 +112,6 @@ def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, 
         )
     for node, values in sets.items():
         out.setdefault(node, {}).update(values)
-    return out
-
-
-def _flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for k, v in d.items():
-        if isinstance(v, dict):
-            out.update(_flatten(v, f"{prefix}{k}."))
-        else:
-            out[f"{prefix}{k}"] = v
     return out
 
 

@@ -57,8 +57,14 @@ class ObserverSettings:
         metadata=param("observer gain c (N s/m prismatic, N m s/rad revolute)", "", 1e-6, 1e6),
     )
     output_limit: float = field(
-        default=4.0,
-        metadata=param("clip of the estimated joint effort; 0 = no clip", "N or N m", 0.0, 1e6),
+        default=0.0,
+        metadata=param(
+            "clip of the estimated joint effort; 0 = no clip (the slide sessions use the thesis's "
+            "4 N)",
+            "N or N m",
+            0.0,
+            1e6,
+        ),
     )
 
     def __post_init__(self) -> None:

@@ -181,3 +181,61 @@ def values_of(obj: Any, prefix: str = "") -> dict[str, ParamValue]:
             v = v.value
         out[spec.name] = list(v) if isinstance(v, tuple) else v
     return out
+
+
+def flatten(tree: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Nested YAML mappings to ROS's dotted parameter names (``{"a": {"b": 1}}`` -> ``a.b``)."""
+    out: dict[str, Any] = {}
+    for k, v in tree.items():
+        if isinstance(v, Mapping):
+            out.update(flatten(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+def load_node_params(path: Any) -> dict[str, dict[str, Any]]:
+    """A ``ros__parameters`` YAML file as ``{node name or "/**": {dotted name: value}}``.
+
+    Node keys may be fully qualified (``/ns/device_node``, ``/**/device_node``); the last part is
+    the name. Raises ``ValueError`` (one line) when the file is not such a file; ``OSError`` when
+    it cannot be read.
+    """
+    import yaml
+
+    with open(path, encoding="utf-8") as fh:
+        text = fh.read()
+    try:
+        doc = yaml.safe_load(text) or {}
+    except yaml.YAMLError as exc:
+        raise ValueError(f"{path} is not valid YAML: {' '.join(str(exc).split())}") from None
+    if not isinstance(doc, dict):
+        raise ValueError(f"{path} must map node names to ros__parameters")
+    out: dict[str, dict[str, Any]] = {}
+    for key, body in doc.items():
+        name = "/**" if key == "/**" else str(key).rsplit("/", 1)[-1]
+        params = body.get("ros__parameters") if isinstance(body, dict) else None
+        if not isinstance(params, dict):
+            raise ValueError(f"{path}: section {key!r} has no ros__parameters mapping")
+        out[name] = flatten(params)
+    return out
+
+
+def node_view(nodes: Mapping[str, Mapping[str, Any]], name: str) -> dict[str, Any]:
+    """The parameters node ``name`` gets: the ``/**`` values overlaid with its own section."""
+    return {**dict(nodes.get("/**", {})), **dict(nodes.get(name, {}))}
+
+
+def replace_groups(obj: Any, **groups: Any) -> Any:
+    """A copy of a dataclass of settings groups: whole groups, or fields as ``group__field=v``."""
+    cfg = dataclasses.replace(obj, **{k: v for k, v in groups.items() if "__" not in k})
+    nested: dict[str, dict[str, Any]] = {}
+    for key, value in groups.items():
+        if "__" in key:
+            group, name = key.split("__", 1)
+            nested.setdefault(group, {})[name] = value
+    for group, fields_ in nested.items():
+        cfg = dataclasses.replace(
+            cfg, **{group: dataclasses.replace(getattr(cfg, group), **fields_)}
+        )
+    return cfg

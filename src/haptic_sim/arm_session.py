@@ -32,11 +32,11 @@ from haptic_dob.models.base import DeviceModel
 from haptic_dob.models.factory import build_model
 from haptic_dob.models.phantom import PhantomModel
 from haptic_dob.observer import ObserverSettings, dls_transpose_solve
-from haptic_msgs_py.params import build
+from haptic_msgs_py.params import build, load_node_params, node_view, replace_groups
 from haptic_sim.arm import ArmDeviceParams, SimulatedArm
 from haptic_sim.hand import HandParams
 from haptic_sim.sensor import ForceSensorParams
-from haptic_sim.session import LoopSettings, _flatten
+from haptic_sim.session import LoopSettings
 
 
 @dataclass(frozen=True)
@@ -63,29 +63,14 @@ class ArmSessionConfig:
 
     def replace(self, **groups: Any) -> ArmSessionConfig:
         """A copy with whole groups replaced, or single fields as ``group__field=value``."""
-        direct = {k: v for k, v in groups.items() if "__" not in k}
-        cfg = dataclasses.replace(self, **direct)
-        for key, value in groups.items():
-            if "__" in key:
-                g, f = key.split("__", 1)
-                cfg = dataclasses.replace(
-                    cfg, **{g: dataclasses.replace(getattr(cfg, g), **{f: value})}
-                )
-        return cfg
+        return replace_groups(self, **groups)
 
     @classmethod
     def from_node_params(cls, nodes: Mapping[str, Mapping[str, Any]]) -> ArmSessionConfig:
         """Build from per-node parameter dicts (``device_node``, ``observer_node``...; ``/**``)."""
-        common = dict(nodes.get("/**", {}))
-
-        def of(name: str) -> dict[str, Any]:
-            return {**common, **dict(nodes.get(name, {}))}
-
         dev, env, obs, ctl = (
-            of("device_node"),
-            of("environment_node"),
-            of("observer_node"),
-            of("controller_node"),
+            node_view(nodes, n)
+            for n in ("device_node", "environment_node", "observer_node", "controller_node")
         )
         if dev.get("model", "slide") == "slide":
             raise ValueError("an arm session needs model phantom or urdf, got slide")
@@ -104,17 +89,7 @@ class ArmSessionConfig:
     @classmethod
     def from_yaml(cls, path: str | Path) -> ArmSessionConfig:
         """Load a ``ros__parameters`` YAML file (the one the node graph is launched with)."""
-        import yaml
-
-        with open(path, encoding="utf-8") as fh:
-            doc = yaml.safe_load(fh) or {}
-        if not isinstance(doc, dict):
-            raise ValueError(f"{path}: expected a mapping of node names to ros__parameters")
-        nodes = {}
-        for name, body in doc.items():
-            params = (body or {}).get("ros__parameters", {}) if isinstance(body, dict) else {}
-            nodes[str(name).rsplit("/", 1)[-1] if name != "/**" else "/**"] = _flatten(params)
-        return cls.from_node_params(nodes)
+        return cls.from_node_params(load_node_params(path))
 
 
 @dataclass
@@ -145,6 +120,27 @@ class ArmSessionResult:
     force_used: np.ndarray
     d_hat: np.ndarray
     d_exact: np.ndarray
+
+    def summary(self, settle_s: float = 0.0) -> dict[str, Any]:
+        """Headline figures after ``settle_s`` seconds: force-estimate error (N, RMS of the 3-D
+        error), contact share and deepest penetration (m)."""
+        cfg = self.config
+        s = slice(min(round(settle_s * cfg.loop.rate_hz), self.t.size // 4), None)
+        err = np.linalg.norm(self.force_estimated[s] - self.tip_force[s], axis=1)
+        depth = (self.ee_true[s] - np.asarray(cfg.wall.position)) @ np.asarray(cfg.wall.normal)
+        out: dict[str, Any] = {
+            "model": type(cfg.plant).__name__,
+            "controller": cfg.law.mode.value,
+            "kf": cfg.law.kf,
+            "stiffness_n_per_m": cfg.wall.stiffness_n_per_m,
+            "observer_gain": cfg.observer.gain,
+            "duration_s": self.t.size / cfg.loop.rate_hz,
+            "seed": cfg.loop.seed,
+            "estimate_rms_error_n": float(np.sqrt(np.mean(err * err))),
+            "max_penetration_m": float(max(depth.max(), 0.0)),
+            "in_contact_pct": float(np.mean(depth > 0.0) * 100.0),
+        }
+        return out
 
     def save(self, path: str | Path) -> None:
         """Write the arrays to an ``.npz`` file."""

@@ -28,7 +28,7 @@ from haptic_dob.environment import VirtualWall
 from haptic_dob.models.slide import SlideParams
 from haptic_dob.observer import ObserverSettings
 from haptic_dob.validation import nonnegative, positive
-from haptic_msgs_py.params import build, param
+from haptic_msgs_py.params import build, load_node_params, node_view, param, replace_groups
 from haptic_sim.hand import HandParams
 from haptic_sim.sensor import ForceSensorParams
 from haptic_sim.slide import SimulatedSlide, SlideDeviceParams
@@ -76,21 +76,13 @@ class SessionConfig:
     hand: HandParams = field(default_factory=HandParams)
     wall: VirtualWall = field(default_factory=VirtualWall)
     law: ImpedanceLaw = field(default_factory=ImpedanceLaw)
-    observer: ObserverSettings = field(default_factory=ObserverSettings)
+    # the thesis clipped the slide's estimate to the actuator's 4 N
+    observer: ObserverSettings = field(default_factory=lambda: ObserverSettings(output_limit=4.0))
     observer_model: SlideParams | None = None
 
     def replace(self, **groups: Any) -> SessionConfig:
         """A copy with whole groups replaced, or single fields as ``group__field=value``."""
-        direct = {k: v for k, v in groups.items() if "__" not in k}
-        cfg = dataclasses.replace(self, **direct)
-        nested: dict[str, dict[str, Any]] = {}
-        for key, value in groups.items():
-            if "__" in key:
-                g, f = key.split("__", 1)
-                nested.setdefault(g, {})[f] = value
-        for g, fields_ in nested.items():
-            cfg = dataclasses.replace(cfg, **{g: dataclasses.replace(getattr(cfg, g), **fields_)})
-        return cfg
+        return replace_groups(self, **groups)
 
     @classmethod
     def from_node_params(cls, nodes: Mapping[str, Mapping[str, Any]]) -> SessionConfig:
@@ -99,16 +91,9 @@ class SessionConfig:
         Keys follow the nodes' parameter names (``slide.mass_kg``, ``hand.offset_m``,
         ``stiffness_n_per_m``, ``mode``, ``gain``...); ``/**`` applies to every node.
         """
-        common = dict(nodes.get("/**", {}))
-
-        def of(name: str) -> dict[str, Any]:
-            return {**common, **dict(nodes.get(name, {}))}
-
         dev, env, obs, ctl = (
-            of("device_node"),
-            of("environment_node"),
-            of("observer_node"),
-            of("controller_node"),
+            node_view(nodes, n)
+            for n in ("device_node", "environment_node", "observer_node", "controller_node")
         )
         model = build(SlideParams, dev, "slide.")
         obs_model = build(SlideParams, obs, "slide.")
@@ -127,28 +112,7 @@ class SessionConfig:
     @classmethod
     def from_yaml(cls, path: str | Path) -> SessionConfig:
         """Load a ``ros__parameters`` YAML file (the one the node graph is launched with)."""
-        import yaml
-
-        with open(path, encoding="utf-8") as fh:
-            doc = yaml.safe_load(fh) or {}
-        if not isinstance(doc, dict):
-            raise ValueError(f"{path}: expected a mapping of node names to ros__parameters")
-        nodes = {}
-        for name, body in doc.items():
-            params = (body or {}).get("ros__parameters", {}) if isinstance(body, dict) else {}
-            nodes[str(name).rsplit("/", 1)[-1] if name != "/**" else "/**"] = _flatten(params)
-        return cls.from_node_params(nodes)
-
-
-def _flatten(d: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    """Nested YAML mappings to ROS's dotted parameter names."""
-    out: dict[str, Any] = {}
-    for k, v in d.items():
-        if isinstance(v, Mapping):
-            out.update(_flatten(v, f"{prefix}{k}."))
-        else:
-            out[f"{prefix}{k}"] = v
-    return out
+        return cls.from_node_params(load_node_params(path))
 
 
 @dataclass

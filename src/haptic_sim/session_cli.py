@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
 
 from haptic_dob.cli import ArgumentParser, run
 from haptic_dob.configs import resolve_config
 from haptic_dob.control import ControlMode
 from haptic_dob.environment import VirtualWall
 from haptic_dob.validation import nonnegative, positive
+from haptic_msgs_py.params import load_node_params, node_view
 from haptic_sim.hand import reference_for_force
 from haptic_sim.session import SessionConfig, run_session
 from haptic_sim.stability import law_for
@@ -26,7 +28,13 @@ def command(
     as_json: bool,
 ) -> int:
     """Load, override, run, print; raises ``ValueError``/``CliError`` on bad input."""
-    cfg = SessionConfig.from_yaml(resolve_config(config))
+    path = resolve_config(config)
+    model = node_view(load_node_params(path), "device_node").get("model", "slide")
+    if model != "slide":
+        summary = run_arm(path, controller, kf, stiffness, duration, seed, save)
+        print_summary(summary, as_json)
+        return 0
+    cfg = SessionConfig.from_yaml(path)
     if controller is not None or kf is not None:
         law = cfg.law
         cfg = cfg.replace(
@@ -48,16 +56,58 @@ def command(
     if save:
         result.save(save)
         summary["saved"] = save
+    print_summary(summary, as_json)
+    return 0
+
+
+def run_arm(
+    path: Path,
+    controller: str | None,
+    kf: float | None,
+    stiffness: float | None,
+    duration: float | None,
+    seed: int | None,
+    save: str | None,
+) -> dict:
+    """A PHANToM or URDF-arm session (``haptic_sim.arm_session``) with the same overrides."""
+    from haptic_sim.arm_session import ArmSessionConfig, run_arm_session
+
+    cfg = ArmSessionConfig.from_yaml(path)
+    if controller is not None or kf is not None:
+        law = cfg.law
+        cfg = cfg.replace(
+            law=law_for(controller or law.mode.value, law.kf if kf is None else kf, law.max_force_n)
+        )
+    if stiffness is not None:
+        w = cfg.wall
+        cfg = cfg.replace(
+            wall=VirtualWall(
+                positive("--stiffness", stiffness), w.damping_n_s_per_m, w.position, w.normal
+            )
+        )
+    if duration is not None:
+        cfg = cfg.replace(loop__duration_s=positive("--duration", duration))
+    if seed is not None:
+        cfg = cfg.replace(loop__seed=int(nonnegative("--seed", seed)))
+    result = run_arm_session(cfg)
+    summary = result.summary()
+    if save:
+        result.save(save)
+        summary["saved"] = save
+    return summary
+
+
+def print_summary(summary: dict, as_json: bool) -> None:
+    """JSON, or one aligned ``key  value`` line per figure."""
     if as_json:
         print(json.dumps(summary, indent=2))
-    else:
-        width = max(len(k) for k in summary)
-        for key, value in summary.items():
-            text = f"{value:.4g}" if isinstance(value, float) else str(value)
-            if value is None:
-                text = "n/a (record too short or no motion)"
-            print(f"{key:<{width}}  {text}")
-    return 0
+        return
+    width = max(len(k) for k in summary)
+    for key, value in summary.items():
+        text = f"{value:.4g}" if isinstance(value, float) else str(value)
+        if value is None:
+            text = "n/a (record too short or no motion)"
+        print(f"{key:<{width}}  {text}")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from concurrent.futures import Executor, ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -181,8 +182,13 @@ def sweep(
     base: SessionConfig | None = None,
     protocol: StabilityProtocol | None = None,
     workers: int = 1,
+    executor: Executor | None = None,
 ) -> StabilitySweep:
-    """Run the protocol over ``stiffnesses`` (N/m, ascending) and locate the onset."""
+    """Run the protocol over ``stiffnesses`` (N/m, ascending) and locate the onset.
+
+    ``executor`` (a process pool) runs the points in parallel and may be shared across sweeps;
+    without one, ``workers > 1`` makes a pool for this sweep.
+    """
     base = base or SessionConfig()
     protocol = protocol or StabilityProtocol()
     ks = [float(k) for k in stiffnesses]
@@ -190,11 +196,12 @@ def sweep(
         raise ValueError("stiffnesses must not be empty")
     if any(b <= a for a, b in itertools.pairwise(ks)):
         raise ValueError("stiffnesses must be strictly ascending")
-    if workers > 1:
-        from concurrent.futures import ProcessPoolExecutor
-
+    args = ([protocol] * len(ks), [base] * len(ks), ks)
+    if executor is not None:
+        points = list(executor.map(growth_at, *args))
+    elif workers > 1:
         with ProcessPoolExecutor(workers) as ex:
-            points = list(ex.map(growth_at, [protocol] * len(ks), [base] * len(ks), ks))
+            points = list(ex.map(growth_at, *args))
     else:
         points = [growth_at(protocol, base, k) for k in ks]
     law = base.law
