@@ -11,7 +11,7 @@ force sensor), ``sim/hand_wrench`` (the true hand force, for evaluation) and, in
   sample idempotently). While a recorder reports its progress (``recorder/progress``), the device
   also holds the next sample when the recorder lags more than ``max_recorder_lag_s`` of simulated
   time, so a recording of a lockstep run never loses a sample. Stops after ``duration_s``
-  (0: never).
+  (0: never), once a recorder (if any) has written the last sample.
 - realtime: ticks at ``rate_hz`` and applies the newest valid command; records whether command k
   arrived before the next tick and its latency (``stats_file``).
 
@@ -62,6 +62,7 @@ from haptic_sim.factory import build_device, simulation_specs
 
 DEFAULT_WAIT_FOR = ["environment_node", "observer_node", "controller_node"]
 STARTUP_RESEND_S = 0.5
+DRAIN_TIMEOUT_S = 10.0  # how long a finished run waits for a recorder to write its last sample
 
 
 def device_node_specs() -> list[ParamSpec]:
@@ -176,6 +177,7 @@ class DeviceNode(LoopNode):
             self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, self._on_command, qos.LOOP_IN
         )
         self._recorder_ns: int | None = None  # newest stamp a recorder has written
+        self._drain_until: float | None = None  # after the last sample: wait for the recorder
         self._held: list[float] | None = None  # a command waiting for the recorder
         if self.lockstep:
             raw_subscription(
@@ -304,6 +306,9 @@ class DeviceNode(LoopNode):
     def _on_progress(self, msg: Any) -> None:
         st = msg.clock
         self._recorder_ns = st.sec * NS_PER_S + st.nanosec
+        if self._drain_until is not None:
+            self._check_drained()
+            return
         if self._held is not None and not self._recorder_lags():
             effort, self._held = self._held, None
             self._step(effort)
@@ -322,20 +327,41 @@ class DeviceNode(LoopNode):
         self.diagnostics.tick()
         if self.lockstep:
             self._deadline = self._sent_s + self.params.values["lockstep_timeout_s"]
-        if self.last_k is not None and s.k >= self.last_k:
-            self.finished = True
+        if self.last_k is not None and s.k >= self.last_k and self._drain_until is None:
             wall = time.monotonic() - self._t_first
             sim = s.k * self.period_ns * 1e-9
             self.get_logger().info(
                 f"finished: {s.k} cycles ({sim:g} s simulated) in {wall:.2f} s, "
                 f"real-time factor {sim / wall:.2f}"
             )
+            # stay up (publishers alive) until a recorder has written the last sample
+            self._drain_until = time.monotonic() + DRAIN_TIMEOUT_S
+            self._deadline = time.monotonic()
+            self._check_drained()
+
+    def _check_drained(self) -> None:
+        """Finish once no recorder reports, or it has written the last sample (or time is up)."""
+        last_ns = self.device.k * self.period_ns
+        if self.count_publishers(RECORDER_PROGRESS) == 0 or (
+            self._recorder_ns is not None and self._recorder_ns >= last_ns
+        ):
+            self.finished = True
+        elif time.monotonic() >= self._drain_until:
+            self.get_logger().warning(
+                f"the recorder has not written the last sample after {DRAIN_TIMEOUT_S:g} s; "
+                "stopping anyway"
+            )
+            self.finished = True
 
     # --- time ------------------------------------------------------------------------------
     def next_wakeup(self) -> float | None:
         return self._deadline
 
     def on_wakeup(self, now: float) -> None:
+        if self._drain_until is not None:  # the run is over: wait for the recorder
+            self._check_drained()
+            self._deadline = now + 0.05
+            return
         if not self.lockstep:
             self._tick(now)
             return
