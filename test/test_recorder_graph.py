@@ -1,0 +1,263 @@
+"""The recorder with the node graph: lossless lockstep recordings, signals, a live mode switch."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from conftest import tool
+from haptic_dob.bag import analyze_bag, read_bag
+from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
+from haptic_dob.bag.reader import open_bag
+from haptic_dob.control import ControlMode, ImpedanceLaw
+from haptic_msgs_py.stamps import NS_PER_S
+from haptic_msgs_py.topics import RECORDER_PROGRESS
+from haptic_sim.session import SessionConfig, run_session
+from rosgraph import Collector, Process, isolated_env, launch, set_parameter
+
+pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
+
+LOOP = ["environment_node", "observer_node", "controller_node"]
+DEVICE_TOPICS = ["/joint_states", "/ee_pose", "/ee_twist", "/wrench_measured", "/sim/hand_wrench"]
+ANSWER_TOPICS = ["/wrench_desired", "/wrench_estimate", "/effort_estimate", "/effort_command"]
+MS = 1_000_000
+
+
+def wait_for(nodes: list[str]) -> str:
+    return f"device_node:wait_for=[{', '.join(LOOP + nodes)}]"
+
+
+#: lockstep must not depend on wall-clock lateness: a loaded machine delays the observer's answer
+#: past the controller's default 20 ms input timeout, and its fallback would change the run
+PATIENT = "controller_node:input_timeout_s=10.0"
+
+
+def resent(log: str) -> list[int]:
+    """Stamps (ns) of the samples the device sent twice (its lockstep re-send after a timeout)."""
+    found = re.findall(r"no effort_command for cycle (\d+) .*Sending the sample again", log)
+    return [int(k) * MS for k in found]
+
+
+def assert_device_topics(
+    stamps: dict[str, np.ndarray], resends: list[int], last: int | None
+) -> None:
+    """Each device sample once from 0 (to ``last``), plus exactly the re-sent ones again."""
+    for topic in DEVICE_TOPICS:
+        s = stamps[topic]
+        unique, counts = np.unique(s, return_counts=True)
+        n = unique.size if last is None else last // MS + 1
+        assert np.array_equal(unique, np.arange(n) * MS), topic
+        twice = sorted(unique[counts > 1].tolist())
+        assert counts.max() <= 2 and twice == sorted(r for r in resends if r <= unique[-1]), topic
+
+
+def bag_stamps(path: Path) -> dict[str, np.ndarray]:
+    """Per topic, the stamps of its messages in bag order (header or effort@ label)."""
+    out: dict[str, list[int]] = {}
+    with open_bag(path) as reader:
+        for conn, _, data in reader.messages():
+            if conn.topic == "/parameter_events":
+                continue
+            read = (
+                command_label_stamp_ns
+                if conn.topic.endswith("effort_command")
+                else (header_stamp_ns)
+            )
+            out.setdefault(conn.topic, []).append(read(data))
+    return {t: np.array(s, dtype=np.int64) for t, s in out.items()}
+
+
+def recorder_report(path: Path) -> dict:
+    """The counts the recorder wrote into the bag's metadata."""
+    meta = yaml.safe_load((path / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    return json.loads(meta["custom_data"]["haptic_dob.recorder"])
+
+
+def message_counts(path: Path) -> dict[str, int]:
+    with open_bag(path) as reader:
+        return {c.topic: c.msgcount for c in reader.connections}
+
+
+def assert_received_written_in_bag(path: Path) -> dict:
+    """received = written for every topic, written = what the bag holds (+ snapshots)."""
+    report = recorder_report(path)
+    counts = message_counts(path)
+    for topic, c in report["topics"].items():
+        extra = report["parameter_snapshots"] if topic == "/parameter_events" else 0
+        assert c["written"] == c["received"] + extra, (path, topic, c)
+        assert counts[topic] == c["written"], (path, topic)
+    return report
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="device_node (a803eb7) keeps stepping after duration_s while it waits for the "
+    "recorder: _on_command must ignore commands once _drain_until is set; remove this mark then",
+)
+def test_recorded_lockstep_session_loses_nothing_and_equals_the_batch_run(root, tmp_path) -> None:
+    """60 s at 1 kHz, DOB Kf=1: an MCAP (launched recorder) and a sqlite3 (haptic-record) bag.
+
+    Every device topic holds samples 0..N once each, plus the samples the device re-sent (it logs
+    each): exactly what it published. Every answer topic holds the cycles 0..N-1; what each
+    recorder received it wrote; both bags analyse to the batch run's ``summary()`` exactly.
+    """
+    seconds = 60.0
+    n = round(seconds * 1000)
+    env = isolated_env()
+    mcap, sqlite = tmp_path / "mcap", tmp_path / "sqlite"
+    rec = Process(
+        [tool("haptic-record"), str(sqlite), "--storage", "sqlite3", "--node-name", "rec_sql"],
+        env,
+        tmp_path / "record.log",
+    )
+    sets = [
+        wait_for(["recorder_node", "rec_sql"]),
+        f"device_node:duration_s={seconds}",
+        "controller_node:mode=DOB",
+        "controller_node:kf=1.0",
+        PATIENT,
+        f"recorder_node:output={mcap}",
+    ]
+    graph = launch(str(root / "config" / "slide_sim.yaml"), env, sets, tmp_path / "launch.log")
+    try:
+        assert graph.wait(300) == 0, graph.output()
+        assert rec.stop(30) == 0, rec.output()
+    finally:
+        graph.stop()
+        rec.stop()
+    resends = resent(graph.output())
+    assert "lost its input" not in graph.output()  # no fallback: the run is the batch run
+    assert f"bag: {sqlite} (sqlite3)" in rec.output()
+    cfg = SessionConfig.from_yaml(root / "config" / "slide_sim.yaml").replace(
+        law=ImpedanceLaw(ControlMode.DOB, 1.0, 4.0), loop__duration_s=seconds
+    )
+    res = run_session(cfg)
+    want = res.summary()
+    for bag in (mcap, sqlite):
+        stamps = bag_stamps(bag)
+        assert_device_topics(stamps, resends, n * MS)
+        for topic in ANSWER_TOPICS:
+            unique = np.unique(stamps[topic])
+            assert np.array_equal(unique[:n], np.arange(n) * MS), (bag, topic)
+        report = assert_received_written_in_bag(bag)
+        assert report["parameter_snapshots"] >= 4  # device, environment, observer, controller
+        assert all(c["gaps"] == 0 for c in report["topics"].values())
+        data = read_bag(bag)
+        assert np.array_equal(data.motion.values[:n], res.q)
+        assert np.array_equal(data.force.values[:n], res.force_measured)
+        (seg,) = analyze_bag(bag).segments
+        got = seg.as_dict()
+        for key in (
+            "bandwidth_hz",
+            "impedance_error_pct",
+            "coherence_in_band",
+            "controller",
+            "kf",
+            "stiffness_n_per_m",
+            "observer_gain",
+        ):
+            assert got[key] == want[key], (bag, key)
+
+
+def switch_stamp(path: Path, kf: float) -> int:
+    """Stamp (ns) of the first command computed by the DOB law (from the recorded signals)."""
+    from haptic_msgs_py.convert import read_force
+
+    by: dict[str, dict[int, float]] = {"/wrench_desired": {}, "/wrench_estimate": {}}
+    cmds: list[tuple[int, float]] = []
+    with open_bag(path) as reader:
+        for conn, _, data in reader.messages():
+            if conn.topic in by:
+                m = reader.deserialize(data, conn.msgtype)
+                by[conn.topic][m.header.stamp.sec * NS_PER_S + m.header.stamp.nanosec] = read_force(
+                    m
+                )[0]
+            elif conn.topic == "/effort_command":
+                m = reader.deserialize(data, conn.msgtype)
+                cmds.append((command_label_stamp_ns(data), float(m.data[0])))  # type: ignore[arg-type]
+    first = None
+    for k, u in sorted(cmds):
+        fw, fe = by["/wrench_desired"][k], by["/wrench_estimate"][k]
+        ol, dob = np.clip(fw, -4, 4), np.clip(fw + kf * (fw + fe), -4, 4)
+        if abs(u - dob) < 1e-12 and abs(u - ol) > 1e-12:
+            first = k if first is None else first
+        elif abs(u - ol) < 1e-12 and abs(u - dob) > 1e-12:
+            assert first is None, "an OL command after the switch"
+    assert first is not None, "no DOB command recorded"
+    return first
+
+
+def test_signals_leave_readable_bags_and_a_live_switch_splits_the_session(root, tmp_path) -> None:
+    """Three recorders on one lockstep run: SIGTERM and SIGINT mid-session, one to the end."""
+    env = isolated_env()
+    a, b, c = tmp_path / "a", tmp_path / "b_term", tmp_path / "c_int"
+    rec_b = Process(
+        [tool("haptic-record"), str(b), "--storage", "sqlite3", "--node-name", "rec_b"],
+        env,
+        tmp_path / "b.log",
+    )
+    rec_c = Process(
+        [tool("haptic-record"), str(c), "--node-name", "rec_c"], env, tmp_path / "c.log"
+    )
+    col = Collector(env, {RECORDER_PROGRESS: "rosgraph_msgs/msg/Clock"})
+    sets = [
+        wait_for(["recorder_node", "rec_b", "rec_c", "collector"]),
+        "device_node:duration_s=0.0",
+        "controller_node:kf=1.0",
+        PATIENT,
+        f"recorder_node:output={a}",
+    ]
+    graph = launch(str(root / "config" / "slide_sim.yaml"), env, sets, tmp_path / "launch.log")
+
+    def progress() -> float:
+        msgs = col.messages(RECORDER_PROGRESS)
+        return max((m.clock.sec + m.clock.nanosec * 1e-9 for m in msgs), default=0.0)
+
+    def reach(seconds: float, timeout: float) -> None:
+        end = time.monotonic() + timeout
+        while progress() < seconds:
+            assert time.monotonic() < end, f"the session did not reach {seconds} s\n" + (
+                graph.output()
+            )
+            time.sleep(0.05)
+
+    try:
+        reach(6.0, 120)
+        ok, reason = set_parameter(env, "controller_node", "mode", "DOB")
+        assert ok, reason
+        reach(12.0, 60)
+        os.killpg(rec_b.proc.pid, signal.SIGTERM)
+        os.killpg(rec_c.proc.pid, signal.SIGINT)
+        assert rec_b.wait(30) == 0, rec_b.output()
+        assert rec_c.wait(30) == 0, rec_c.output()
+        reach(15.0, 60)
+    finally:
+        graph.stop()
+        col.close()
+        rec_b.stop()
+        rec_c.stop()
+    resends = resent(graph.output())
+    for bag, proc, storage in ((b, rec_b, "sqlite3"), (c, rec_c, "mcap")):
+        assert f"bag: {bag} ({storage})" in proc.output()
+        assert_received_written_in_bag(bag)
+        stamps = bag_stamps(bag)
+        assert stamps["/ee_pose"].size > 10_000
+        assert_device_topics(stamps, resends, None)  # from sample 0 on, none missing
+    assert_received_written_in_bag(a)
+    analysis = analyze_bag(a)
+    segs = analysis.segments
+    assert [s.controller for s in segs] == ["OL", "DOB"]
+    assert [s.kf for s in segs] == [1.0, 1.0]
+    assert all(s.figures.transparency is not None for s in segs)
+    k_switch = switch_stamp(a, 1.0)
+    boundary = round(segs[1].start_s * NS_PER_S)
+    assert 6.0 * NS_PER_S <= k_switch <= 12.0 * NS_PER_S
+    assert abs(boundary - k_switch) <= 5 * MS, (boundary, k_switch)

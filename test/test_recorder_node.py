@@ -1,0 +1,212 @@
+"""The recorder in-process and its command line: topics, stamps, counts, snapshots, progress."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
+
+from conftest import tool
+from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
+from haptic_dob.bag.reader import open_bag
+from haptic_dob.nodes.recorder_node import (
+    DEFAULT_TOPICS,
+    RecorderNode,
+    parse_topics,
+    stamp_reader,
+)
+from haptic_msgs_py import wire
+from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.raw import RawPublisher
+from haptic_msgs_py.stamps import command_label
+from haptic_msgs_py.topics import EE_POSE, EFFORT_COMMAND, PARAMETER_EVENTS, SESSION_TOPICS
+from rosgraph import isolated_env
+
+
+def test_topics_default_and_parsing() -> None:
+    assert [*SESSION_TOPICS, PARAMETER_EVENTS] == DEFAULT_TOPICS
+    assert parse_topics(["ee_pose", "/parameter_events", "/other:std_msgs/msg/String"]) == [
+        ("ee_pose", "geometry_msgs/msg/PoseStamped"),
+        ("/parameter_events", "rcl_interfaces/msg/ParameterEvent"),
+        ("/other", "std_msgs/msg/String"),
+    ]
+    with pytest.raises(ValueError, match="'odometry' is not a session topic; give its type"):
+        parse_topics(["odometry"])
+    with pytest.raises(ValueError, match="unknown message type 'foo/msg/Bar' for x"):
+        parse_topics(["x:foo/msg/Bar"])
+    with pytest.raises(ValueError, match="ee_pose is listed twice"):
+        parse_topics(["ee_pose", "ee_pose"])
+
+
+def test_stamps_are_read_from_the_bytes() -> None:
+    pose = wire.pose_stamped("base_link")
+    pose.header.stamp.sec, pose.header.stamp.nanosec = 12, 345_000_000
+    assert header_stamp_ns(wire.encode(pose)) == 12_345_000_000
+    cmd = wire.float64_multi_array(command_label(7_000_000), [0.5])
+    assert command_label_stamp_ns(wire.encode(cmd)) == 7_000_000
+    assert command_label_stamp_ns(wire.encode(wire.float64_multi_array("x", [0.5]))) is None
+    assert stamp_reader("/ee_pose", SESSION_TOPICS[EE_POSE]) is header_stamp_ns
+    assert stamp_reader("/ns/effort_command", SESSION_TOPICS[EFFORT_COMMAND]) is (
+        command_label_stamp_ns
+    )
+    assert stamp_reader("/parameter_events", "rcl_interfaces/msg/ParameterEvent") is None
+
+
+@pytest.fixture
+def context(monkeypatch: pytest.MonkeyPatch):
+    env = isolated_env()
+    monkeypatch.setenv("ROS_DOMAIN_ID", env["ROS_DOMAIN_ID"])
+    ctx = Context()
+    rclpy.init(context=ctx, args=[])
+    yield ctx
+    rclpy.try_shutdown(context=ctx)
+
+
+def spin_until(ex: SingleThreadedExecutor, done, timeout: float) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if done():
+            return True
+        ex.spin_once(timeout_sec=0.01)
+    return done()
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_records_counts_snapshots_and_reports_progress(context, tmp_path, storage) -> None:
+    """Poses with one missing stamp, commands, a node's parameters: all in a readable bag."""
+    out = tmp_path / "bag"
+    rec = RecorderNode(
+        context=context,
+        parameter_overrides=[
+            Parameter("output", value=str(out)),
+            Parameter("storage", value=storage),
+            Parameter("topics", value=["ee_pose", "effort_command", "/parameter_events"]),
+        ],
+    )
+    src = rclpy.create_node("environment_node", context=context)
+    src.declare_parameter("stiffness_n_per_m", 800.0)
+    pose_pub = RawPublisher(src, SESSION_TOPICS[EE_POSE], EE_POSE, qos.LOOP)
+    cmd_pub = RawPublisher(src, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, qos.LOOP)
+    ex = SingleThreadedExecutor(context=context)
+    ex.add_node(rec)
+    ex.add_node(src)
+    try:
+        assert spin_until(ex, lambda: rec.snapshots == 1, 10.0), "no parameter snapshot"
+        assert rec.progress_ns() == 0  # publishers matched, nothing written yet
+        pose = wire.pose_stamped("base_link")
+        stamps = [k * 1_000_000 for k in range(200) if k != 50]  # sample 50 never sent
+        for s in stamps:
+            pose.header.stamp.sec, pose.header.stamp.nanosec = divmod(s, 1_000_000_000)
+            pose_pub.publish(pose)
+            cmd_pub.publish(wire.float64_multi_array(command_label(s), [0.1]))
+        assert spin_until(ex, lambda: rec.counts[1].received == len(stamps), 10.0)
+        assert rec.progress_ns() == stamps[-1]
+        live = rec.counts[2].received  # the node's own declarations, if they came in time
+        src.set_parameters([Parameter("stiffness_n_per_m", value=1600.0)])
+        assert spin_until(ex, lambda: rec.counts[2].received == live + 1, 10.0)
+    finally:
+        ex.shutdown()
+        rec.close()
+        src.destroy_node()
+        rec.destroy_node()
+    pose_c, cmd_c, ev_c = rec.counts
+    assert (pose_c.received, pose_c.written, pose_c.gaps) == (199, 199, 1)
+    assert (cmd_c.received, cmd_c.written, cmd_c.gaps) == (199, 199, 1)
+    assert (pose_c.first_ns, pose_c.newest_ns) == (0, 199_000_000)
+    assert ev_c.written == ev_c.received + 1  # the live events and the snapshot
+    with open_bag(out) as reader:
+        counts = {c.topic: c.msgcount for c in reader.connections}
+        assert counts == {
+            "/ee_pose": 199,
+            "/effort_command": 199,
+            "/parameter_events": ev_c.written,
+        }
+        events = [
+            reader.deserialize(d, c.msgtype)
+            for c, _, d in reader.messages()
+            if c.topic == "/parameter_events"
+        ]
+    env = [e for e in events if e.node == "/environment_node"]
+    snaps = [
+        e
+        for e in env
+        if {p.name for p in e.new_parameters} >= {"stiffness_n_per_m", "use_sim_time"}
+    ]
+    assert len(snaps) == 1 and not snaps[0].changed_parameters
+    values = {p.name: p.value.double_value for p in snaps[0].new_parameters}
+    assert values["stiffness_n_per_m"] == 800.0
+    assert [(p.name, p.value.double_value) for p in env[-1].changed_parameters] == [
+        ("stiffness_n_per_m", 1600.0)
+    ]
+    meta = (out / "metadata.yaml").read_text()
+    assert "haptic_dob.recorder" in meta
+    report = rec.report()
+    assert report["topics"]["/ee_pose"]["written"] == 199
+    assert json.loads(json.dumps(report)) == report
+
+
+def test_refuses_to_overwrite_and_names_bad_topics(tmp_path: Path) -> None:
+    existing = tmp_path / "bag"
+    existing.mkdir()
+    out = subprocess.run(
+        [tool("haptic-record"), str(existing)], capture_output=True, text=True, timeout=60
+    )
+    assert out.returncode == 2
+    assert out.stderr == (
+        f"ERROR: {existing} exists already; the recorder never overwrites a bag\n"
+    )
+    env = isolated_env()
+    out = subprocess.run(
+        [tool("haptic-record"), str(tmp_path / "new"), "--topic", "odometry"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
+    assert out.returncode == 2, out.stderr
+    assert (
+        out.stderr.strip()
+        .splitlines()[-1]
+        .startswith(
+            "ERROR: topics: 'odometry' is not a session topic; give its type as "
+            "odometry:pkg/msg/Type"
+        )
+    )
+    assert "Traceback" not in out.stderr
+    assert not (tmp_path / "new").exists()
+    out = subprocess.run(
+        [tool("haptic-record"), str(tmp_path / "x"), "--duration", "-1"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert (out.returncode, out.stderr) == (2, "ERROR: --duration must be >= 0 s, got -1\n")
+    out = subprocess.run(
+        [tool("haptic-record"), "--storage", "rosbag1"], capture_output=True, text=True, timeout=60
+    )
+    assert out.returncode == 2
+    assert out.stderr.splitlines()[-1].startswith("ERROR: argument --storage: invalid choice")
+
+
+def test_duration_stops_and_prints_the_counts(tmp_path: Path) -> None:
+    env = isolated_env()
+    out = subprocess.run(
+        [tool("haptic-record"), str(tmp_path / "bag"), "--duration", "0.5", "--storage", "sqlite3"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0].split()[:5] == ["topic", "type", "received", "written", "gaps"]
+    assert lines[1].split()[:5] == ["/joint_states", "sensor_msgs/msg/JointState", "0", "0", "0"]
+    assert lines[-1] == f"bag: {tmp_path / 'bag'} (sqlite3)"
+    assert (tmp_path / "bag" / "metadata.yaml").exists()
