@@ -185,6 +185,8 @@ def switch_stamp(path: Path, kf: float) -> int:
                 cmds.append((command_label_stamp_ns(data), float(m.data[0])))  # type: ignore[arg-type]
     first = None
     for k, u in sorted(cmds):
+        if k not in by["/wrench_estimate"]:
+            continue  # the observer missed this sample (best-effort input): OL needs none
         fw, fe = by["/wrench_desired"][k], by["/wrench_estimate"][k]
         ol, dob = np.clip(fw, -4, 4), np.clip(fw + kf * (fw + fe), -4, 4)
         if abs(u - dob) < 1e-12 and abs(u - ol) > 1e-12:
