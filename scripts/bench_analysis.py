@@ -26,6 +26,7 @@ import platform
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -93,7 +94,11 @@ def run_once(bag: Path) -> tuple[float, float]:
 
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--dir", default="/tmp/haptic_dob_bench_bags", help="where the bags are kept")
+    p.add_argument(
+        "--dir",
+        default=str(Path(tempfile.gettempdir()) / "haptic_dob_bench_bags"),
+        help="where the bags are kept (default: haptic_dob_bench_bags in the temp directory)",
+    )
     p.add_argument("--only", choices=sorted(BAGS), help="one bag only")
     p.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
     p.add_argument("--runs", type=int, help="runs per bag (default 5 for 40s, 3 for 1h)")
