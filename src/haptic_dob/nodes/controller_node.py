@@ -9,9 +9,12 @@ carry (bumpless). A switch to CL or DOB is refused while its force input is not 
 observer must be warm before DOB takes over).
 
 Fallback: when the force input the mode needs stops (the observer died in DOB, the sensor stream in
-CL) -- its newest sample is ``input_timeout_s`` older than the cycle, or a cycle waited that long
-for it -- the controller renders with ``fallback`` (``zero``: no force; ``OL``: the wall force
-alone), says so, and returns to its mode once the input flows again (warm, as for a switch).
+CL) -- its newest sample is more than ``input_timeout_s`` of sample time older than the cycle --
+the controller renders with ``fallback`` (``zero``: no force; ``OL``: the wall force alone), says
+so, and returns to its mode once the input flows again (warm, as for a switch). Only sample
+stamps decide, never the wall clock, so a lockstep run stays deterministic under any load (a dead
+input stalls it instead, and the device and controller say which input is missing); in real time
+the device's watchdog zeroes the force while the controller waits.
 Without the wall force (``wrench_desired``) it sends nothing and the device's watchdog zeroes the
 effort. ``/diagnostics`` reports the mode, the fallback state and the inputs still awaited.
 """
@@ -235,7 +238,7 @@ class ControllerNode(LoopNode):
             elif not self.fallback_reason:
                 timeout_ns = self.params.values["input_timeout_s"] * 1e9
                 if k - src.stamp <= timeout_ns:
-                    return  # on its way: wait for it (on_wakeup gives up after input_timeout_s)
+                    return  # on its way: wait for it
                 self._fall_back(f"{topic} silent for {(k - src.stamp) * 1e-6:.0f} ms of samples")
         if k != self._sent_ns:
             if self.fallback_reason is None:
@@ -274,34 +277,13 @@ class ControllerNode(LoopNode):
         )
 
     def next_wakeup(self) -> float | None:
-        """While a cycle is pending: when to give up on its force input, or to warn."""
-        if self._newest_ns <= self._sent_ns:
-            return None
-        force = self._force_input()
-        if (
-            force is not None
-            and not self.fallback_reason
-            and self.desired.stamp == self._newest_ns
-            and force[0].stamp != self._newest_ns
-        ):
-            return self._pending_since + self.params.values["input_timeout_s"]
-        if self._newest_ns != self._warned_ns:
+        """While a cycle is pending: when to name the inputs it still lacks."""
+        if self._newest_ns > self._sent_ns and self._newest_ns != self._warned_ns:
             return self._pending_since + self.params.values["input_warn_s"]
         return None
 
     def on_wakeup(self, now: float) -> None:
-        """Fall back for a cycle whose force input is overdue, or name what it lacks (once)."""
-        force = self._force_input()
-        if (
-            force is not None
-            and not self.fallback_reason
-            and self.desired.stamp == self._newest_ns
-            and force[0].stamp != self._newest_ns
-        ):
-            waited = now - self._pending_since
-            self._fall_back(f"{force[1]} of the cycle {waited * 1e3:.0f} ms late")
-            self._emit()
-            return
+        """Name the inputs a pending cycle still lacks (once per cycle)."""
         self._warned_ns = self._newest_ns
         self.get_logger().warning(
             f"cycle at stamp {self._newest_ns * 1e-9:.3f} s still lacks "

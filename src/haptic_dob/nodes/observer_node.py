@@ -187,8 +187,7 @@ class ObserverNode(LoopNode):
         self._wrench.header.stamp = stamp
         self._effort.header.stamp = stamp
         self._pub_wrench.publish(self._wrench)
-        if self._pub_effort.get_subscription_count():
-            self._pub_effort.publish(self._effort)
+        self._pub_effort.publish(self._effort)
 
     def _complain(self, reason: str) -> None:
         if reason != self._bad_input_logged:  # once per distinct problem, not at 1 kHz

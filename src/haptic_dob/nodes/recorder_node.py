@@ -11,8 +11,8 @@
   says which stiffness, mode and gains were active at every moment. Nodes that start later are
   snapshot when they appear.
 - Publishes ``recorder/progress`` (``rosgraph_msgs/Clock``, reliable, transient local) at
-  ``progress_rate_hz``: the newest stamp written, minimum over the stamped topics that have a
-  publisher (header stamps; the effort command's ``effort@<stamp>`` label). A lockstep device
+  ``progress_rate_hz``: the newest stamp written, minimum over the stamped topics that are
+  flowing (header stamps; the effort command's ``effort@<stamp>`` label). A lockstep device
   holds the loop while that lags, so a recorded lockstep run loses nothing.
 - On SIGINT/SIGTERM (or after ``duration_s``) it takes what is still queued (at most
   ``drain_timeout_s``, until nothing arrives for 0.1 s), then closes the bag so it is readable,
@@ -68,6 +68,7 @@ OTHER_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=qos.LOOP_HISTORY, reliability=ReliabilityPolicy.RELIABLE
 )
 DISCOVERY_S = 0.1  # how often new nodes and pending snapshots are looked at
+FLOWING_NS = 1_000_000_000  # a topic this far behind the newest one has stopped (ns)
 QUIET_S = 0.1  # the shutdown drain ends after this long without a message
 
 
@@ -298,9 +299,17 @@ class RecorderNode(LoopNode):
         return on_message
 
     def progress_ns(self) -> int:
-        """Newest stamp written, minimum over stamped topics that have a publisher (ns)."""
-        newest = [c.newest_ns or 0 for sub, c in self._stamped if sub.get_publisher_count() > 0]
-        return min(newest) if newest else 0
+        """Newest stamp written (ns), minimum over the stamped topics that are flowing.
+
+        A topic counts while its newest stamp is within ``FLOWING_NS`` of the newest stamp of
+        any topic: one that has stopped (its node died, or it publishes only on demand) must not
+        hold a lockstep loop forever.
+        """
+        newest = [c.newest_ns for _, c in self._stamped if c.newest_ns is not None]
+        if not newest:
+            return 0
+        top = max(newest)
+        return min(n for n in newest if n >= top - FLOWING_NS)
 
     def _publish_progress(self) -> None:
         if self._closed:

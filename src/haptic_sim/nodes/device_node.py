@@ -29,6 +29,7 @@ import json
 import math
 import sys
 import time
+from collections import deque
 from collections.abc import Mapping
 from typing import Any
 
@@ -63,6 +64,7 @@ from haptic_sim.factory import build_device, simulation_specs
 DEFAULT_WAIT_FOR = ["environment_node", "observer_node", "controller_node"]
 STARTUP_RESEND_S = 0.5
 DRAIN_TIMEOUT_S = 10.0  # how long a finished run waits for a recorder to write its last sample
+PROGRESS_WINDOW_S = 0.2  # recorder progress reports considered (each recorder sends >= 20 Hz)
 
 
 def device_node_specs() -> list[ParamSpec]:
@@ -176,7 +178,8 @@ class DeviceNode(LoopNode):
         self._sub = raw_subscription(
             self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, self._on_command, qos.LOOP_IN
         )
-        self._recorder_ns: int | None = None  # newest stamp a recorder has written
+        self._recorder_ns: int | None = None  # newest stamp the slowest recorder has written
+        self._progress_reports: deque[tuple[float, int]] = deque()
         self._drain_until: float | None = None  # after the last sample: wait for the recorder
         self._held: list[float] | None = None  # a command waiting for the recorder
         if self.lockstep:
@@ -278,6 +281,8 @@ class DeviceNode(LoopNode):
         if self.lockstep:
             if not self._started or (stamp is not None and stamp != current):
                 return  # stale, duplicate, or before the run started
+            if self._drain_until is not None:
+                return  # the run is over: the last sample is out
             effort = self._checked(msg.data)
             if effort is None:
                 effort = self._zero  # a refused command is zero effort; the loop goes on
@@ -305,7 +310,13 @@ class DeviceNode(LoopNode):
 
     def _on_progress(self, msg: Any) -> None:
         st = msg.clock
-        self._recorder_ns = st.sec * NS_PER_S + st.nanosec
+        now = time.monotonic()
+        reports = self._progress_reports
+        reports.append((now, st.sec * NS_PER_S + st.nanosec))
+        while reports and reports[0][0] < now - PROGRESS_WINDOW_S:
+            reports.popleft()
+        # several recorders each report every 20 ms: follow the slowest of the window
+        self._recorder_ns = min(ns for _, ns in reports)
         if self._drain_until is not None:
             self._check_drained()
             return
