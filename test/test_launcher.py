@@ -154,3 +154,28 @@ def test_a_refused_node_parameter_stops_the_graph_with_its_reason(root, tmp_path
     assert out.returncode == 1
     assert "parameter kf refused" in out.stderr
     assert "controller_node exited with code 2" in out.stderr
+
+
+@pytest.mark.multiprocess
+def test_record_option_writes_a_complete_bag(root, tmp_path) -> None:
+    """--record adds a recorder the device waits for: every sample of the run is in the bag."""
+    import json as _json
+
+    bag = tmp_path / "run"
+    out = launch_cli(
+        str(root / "config" / "slide_sim.yaml"),
+        "--record",
+        str(bag),
+        "--set",
+        "device_node:duration_s=3.0",
+    )
+    assert out.returncode == 0, out.stderr
+    res = subprocess.run(
+        [tool("haptic-analyze"), str(bag), "--json"], capture_output=True, text=True, timeout=60
+    )
+    assert res.returncode == 0, res.stderr
+    (seg,) = _json.loads(res.stdout)
+    assert seg["missing_samples"] == 0 and seg["controller"] == "OL"
+    assert seg["duration_s"] == pytest.approx(3.0, abs=0.002)
+    again = launch_cli(str(root / "config" / "slide_sim.yaml"), "--record", str(bag))
+    assert again.returncode == 2 and "exists already" in again.stderr

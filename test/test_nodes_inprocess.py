@@ -159,13 +159,15 @@ def test_device_holds_the_loop_while_a_recorder_lags(context) -> None:
         for k in range(600):  # 0.6 s of simulated time, no recorder yet: the loop runs freely
             dev._on_command(wire.float64_multi_array(command_label(k * period), [0.0]))
         assert dev.device.k == 600
-        progress = wire.clock()
-        progress.clock = wire.Time(sec=0, nanosec=50_000_000)  # the recorder has written 0.05 s
-        dev._on_progress(progress)
+        fast, slow = wire.header("/fast_recorder"), wire.header("/slow_recorder")
+        fast.stamp = wire.Time(sec=0, nanosec=590_000_000)
+        slow.stamp = wire.Time(sec=0, nanosec=50_000_000)  # has written 0.05 s
+        dev._on_progress(fast)
+        dev._on_progress(slow)
         dev._on_command(wire.float64_multi_array(command_label(600 * period), [0.0]))
-        assert dev.device.k == 600 and dev._held is not None  # 0.55 s behind > 0.5 s: held
-        progress.clock = wire.Time(sec=0, nanosec=400_000_000)
-        dev._on_progress(progress)  # caught up to 0.2 s behind: released
+        assert dev.device.k == 600 and dev._held is not None  # the slowest is 0.55 s behind: held
+        slow.stamp = wire.Time(sec=0, nanosec=400_000_000)
+        dev._on_progress(slow)  # caught up to 0.2 s behind: released
         assert dev.device.k == 601 and dev._held is None
         res = dev.set_parameters([Parameter("max_recorder_lag_s", value=0.0)])[0]
         assert not res.successful

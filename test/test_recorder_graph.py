@@ -198,7 +198,7 @@ def test_signals_leave_readable_bags_and_a_live_switch_splits_the_session(root, 
     rec_c = Process(
         [tool("haptic-record"), str(c), "--node-name", "rec_c"], env, tmp_path / "c.log"
     )
-    col = Collector(env, {RECORDER_PROGRESS: "rosgraph_msgs/msg/Clock"})
+    col = Collector(env, {RECORDER_PROGRESS: "std_msgs/msg/Header"})
     sets = [
         wait_for(["recorder_node", "rec_b", "rec_c", "collector"]),
         "device_node:duration_s=0.0",
@@ -209,7 +209,7 @@ def test_signals_leave_readable_bags_and_a_live_switch_splits_the_session(root, 
 
     def progress() -> float:
         msgs = col.messages(RECORDER_PROGRESS)
-        return max((m.clock.sec + m.clock.nanosec * 1e-9 for m in msgs), default=0.0)
+        return max((m.stamp.sec + m.stamp.nanosec * 1e-9 for m in msgs), default=0.0)
 
     def reach(seconds: float, timeout: float) -> None:
         end = time.monotonic() + timeout

@@ -115,6 +115,17 @@ def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, 
     return out
 
 
+def add_recorder(params: dict[str, Any], output: str, storage: str) -> None:
+    """A ``recorder_node`` writing ``output``, and the device waiting for it (loses nothing)."""
+    if Path(output).exists():
+        raise CliError(f"--record {output}: it exists already; the recorder never overwrites a bag")
+    params.setdefault("recorder_node", {}).update(output=output, storage=storage)
+    device = params.setdefault("device_node", {})
+    wait = list(device.get("wait_for", ["environment_node", "observer_node", "controller_node"]))
+    if "recorder_node" not in wait:
+        device["wait_for"] = [*wait, "recorder_node"]
+
+
 def write_params_file(params: dict[str, Any], directory: Path) -> Path:
     """A ``ros__parameters`` file any namespace matches (``/**/<node>`` keys), for this launch."""
     doc = {}
@@ -275,12 +286,16 @@ def command(
     only: Sequence[str] = (),
     network: str = "localhost",
     peers: Sequence[str] = (),
+    record: str | None = None,
+    record_storage: str = "mcap",
 ) -> int:
     """Resolve, plan and run; raises ``CliError`` on bad input."""
     import tempfile
 
     path = resolve_config(config)
     params = resolved_params(path, parse_sets(sets))
+    if record:
+        add_recorder(params, record, record_storage)
     net = network_env(network, peers)
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
         specs = select(plan(params, write_params_file(params, Path(tmp)), namespace), only)
@@ -343,6 +358,14 @@ def main(argv: list[str] | None = None) -> int:
         metavar="HOST[,HOST...]",
         help="other hosts to discover directly (ROS_STATIC_PEERS; needs --network subnet)",
     )
+    p.add_argument(
+        "--record",
+        metavar="BAG",
+        help="record the session into this new bag (a recorder_node the device waits for)",
+    )
+    p.add_argument(
+        "--record-storage", choices=["mcap", "sqlite3"], default="mcap", help="default mcap"
+    )
     a = p.parse_args(argv)
     only = [n for n in a.only.split(",") if n]
     peers = [h for h in a.peers.split(",") if h]
@@ -358,6 +381,8 @@ def main(argv: list[str] | None = None) -> int:
             only,
             a.network,
             peers,
+            a.record,
+            a.record_storage,
         )
     )
 

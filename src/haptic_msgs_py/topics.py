@@ -22,7 +22,8 @@ EFFORT_ESTIMATE = "effort_estimate"  # sensor_msgs/JointState: estimated externa
 EFFORT_COMMAND = "effort_command"  # std_msgs/Float64MultiArray, joint order
 DIAGNOSTICS = "/diagnostics"  # diagnostic_msgs/DiagnosticArray
 # recorder -> device (lockstep back-pressure): the newest stamp written for every recorded topic
-RECORDER_PROGRESS = "recorder/progress"  # rosgraph_msgs/Clock
+# (std_msgs/Header: stamp, and the recorder's name in frame_id)
+RECORDER_PROGRESS = "recorder/progress"
 PARAMETER_EVENTS = "/parameter_events"  # rcl_interfaces/ParameterEvent
 
 #: the topics of one session and their message types (what the recorder records)

@@ -95,6 +95,13 @@ def controller_node_specs() -> list[ParamSpec]:
             3600.0,
         ),
         ParamSpec(
+            "warm_inputs",
+            True,
+            "subscribe to every mode's force input, so a switch to CL or DOB finds it flowing "
+            "(false: only the start mode's input; cheaper; a switch to another mode is refused)",
+            read_only=True,
+        ),
+        ParamSpec(
             "fallback",
             "zero",
             "what to render when the mode's force input stops: zero force or OL",
@@ -103,8 +110,8 @@ def controller_node_specs() -> list[ParamSpec]:
         ParamSpec(
             "input_timeout_s",
             0.02,
-            "the mode's force input counts as stopped after this long (wall time for a waiting "
-            "cycle, stamp time for its newest sample)",
+            "the mode's force input counts as stopped when its newest sample is this much sample "
+            "time older than the cycle",
             "s",
             0.001,
             10.0,
@@ -138,11 +145,13 @@ class ControllerNode(LoopNode):
         self._cmd = wire.float64_multi_array("", [0.0] * self.model.dof)
         self._dim = self._cmd.layout.dim[0]
         self._pub = RawPublisher(self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, qos.LOOP)
-        inputs = [
-            (WRENCH_DESIRED, self._on_desired),
-            (WRENCH_MEASURED, self._on_measured),
-            (WRENCH_ESTIMATE, self._on_estimated),
-        ]
+        inputs = [(WRENCH_DESIRED, self._on_desired)]
+        warm = values["warm_inputs"]
+        start_need = self.controller.law.needs
+        if warm or start_need == "measured":
+            inputs.append((WRENCH_MEASURED, self._on_measured))
+        if warm or start_need == "estimated":
+            inputs.append((WRENCH_ESTIMATE, self._on_estimated))
         if self._needs_q:
             inputs.append((JOINT_STATES, self._on_joint_states))
         for topic, callback in inputs:

@@ -10,7 +10,8 @@
   parameters in ``new_parameters``, on ``/parameter_events`` beside the live events, so the bag
   says which stiffness, mode and gains were active at every moment. Nodes that start later are
   snapshot when they appear.
-- Publishes ``recorder/progress`` (``rosgraph_msgs/Clock``, reliable, transient local) at
+- Publishes ``recorder/progress`` (``std_msgs/Header``: the stamp, and this recorder's name in
+  ``frame_id`` so a device can follow the slowest of several; reliable, transient local) at
   ``progress_rate_hz``: the newest stamp written, minimum over the stamped topics that are
   flowing (header stamps; the effort command's ``effort@<stamp>`` label). A lockstep device
   holds the loop while that lags, so a recorded lockstep run loses nothing.
@@ -246,10 +247,10 @@ class RecorderNode(LoopNode):
         self._ticks = 0
         if self._events_conn is not None:
             self.create_timer(DISCOVERY_S, self._on_discovery)
-        from rosgraph_msgs.msg import Clock
+        from std_msgs.msg import Header
 
-        self._clock_msg = Clock()
-        self._progress = self.create_publisher(Clock, RECORDER_PROGRESS, PROGRESS_QOS)
+        self._progress_msg = Header(frame_id=self.get_fully_qualified_name())
+        self._progress = self.create_publisher(Header, RECORDER_PROGRESS, PROGRESS_QOS)
         self.create_timer(1.0 / v["progress_rate_hz"], self._publish_progress)
         self.get_logger().info(f"recording {len(topics)} topic(s) to {self.path} ({self.storage})")
 
@@ -315,8 +316,8 @@ class RecorderNode(LoopNode):
         if self._closed:
             return
         sec, nsec = divmod(self.progress_ns(), NS_PER_S)
-        self._clock_msg.clock.sec, self._clock_msg.clock.nanosec = sec, nsec
-        self._progress.publish(self._clock_msg)
+        self._progress_msg.stamp.sec, self._progress_msg.stamp.nanosec = sec, nsec
+        self._progress.publish(self._progress_msg)
 
     # --- parameter snapshots ---------------------------------------------------------------
     def _on_discovery(self) -> None:

@@ -29,7 +29,6 @@ import json
 import math
 import sys
 import time
-from collections import deque
 from collections.abc import Mapping
 from typing import Any
 
@@ -64,7 +63,7 @@ from haptic_sim.factory import build_device, simulation_specs
 DEFAULT_WAIT_FOR = ["environment_node", "observer_node", "controller_node"]
 STARTUP_RESEND_S = 0.5
 DRAIN_TIMEOUT_S = 10.0  # how long a finished run waits for a recorder to write its last sample
-PROGRESS_WINDOW_S = 0.2  # recorder progress reports considered (each recorder sends >= 20 Hz)
+RECORDER_STALE_S = 1.0  # a recorder silent this long no longer holds the loop
 
 
 def device_node_specs() -> list[ParamSpec]:
@@ -179,12 +178,12 @@ class DeviceNode(LoopNode):
             self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, self._on_command, qos.LOOP_IN
         )
         self._recorder_ns: int | None = None  # newest stamp the slowest recorder has written
-        self._progress_reports: deque[tuple[float, int]] = deque()
+        self._recorders: dict[str, tuple[float, int]] = {}  # name -> (wall time, stamp)
         self._drain_until: float | None = None  # after the last sample: wait for the recorder
         self._held: list[float] | None = None  # a command waiting for the recorder
         if self.lockstep:
             raw_subscription(
-                self, "rosgraph_msgs/msg/Clock", RECORDER_PROGRESS, self._on_progress, qos.CLOCK
+                self, "std_msgs/msg/Header", RECORDER_PROGRESS, self._on_progress, qos.CLOCK
             )
         self._zero = [0.0] * self.dof
         self._latest = self._zero
@@ -309,14 +308,12 @@ class DeviceNode(LoopNode):
             self._latency_s.append(now - self._sent_s)
 
     def _on_progress(self, msg: Any) -> None:
-        st = msg.clock
+        st = msg.stamp
         now = time.monotonic()
-        reports = self._progress_reports
-        reports.append((now, st.sec * NS_PER_S + st.nanosec))
-        while reports and reports[0][0] < now - PROGRESS_WINDOW_S:
-            reports.popleft()
-        # several recorders each report every 20 ms: follow the slowest of the window
-        self._recorder_ns = min(ns for _, ns in reports)
+        reports = self._recorders
+        reports[msg.frame_id] = (now, st.sec * NS_PER_S + st.nanosec)
+        # follow the slowest recorder that still reports (each sends at least 20 times a second)
+        self._recorder_ns = min(ns for t, ns in reports.values() if t >= now - RECORDER_STALE_S)
         if self._drain_until is not None:
             self._check_drained()
             return

@@ -1,0 +1,164 @@
+"""Runs through the ROS 2 node graph: one lockstep session per run, recorded, resumable.
+
+A run is a full set of node parameters (the slide session config with overrides) plus a
+recorder. ``execute`` writes ``params.yaml`` into the run's directory, starts the graph with
+``haptic-launch`` on a domain of its own (localhost discovery), lets the device finish its
+``duration_s`` (the recorder holds the loop back while it lags, and the device waits for it to
+write the last sample), and marks the run ``complete``. A complete run is never run again: an
+interrupted experiment resumes from the bags already written.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import random
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from haptic_dob.launcher import add_recorder
+from haptic_msgs_py.params import load_node_params
+
+COMPLETE = "complete"
+
+
+@dataclass(frozen=True)
+class GraphRun:
+    """One recorded lockstep session: a name, its node parameters and a wall-clock budget."""
+
+    name: str
+    params: dict[str, dict[str, Any]]  # node name or "/**" -> dotted parameter values
+    label: str = ""
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def duration_s(self) -> float:
+        """Simulated length of the session (s)."""
+        return float(self.params["device_node"]["duration_s"])
+
+
+def session_params(base_config: Path, overrides: dict[str, dict[str, Any]]) -> dict:
+    """The base config's node sections with ``overrides`` laid over them."""
+    params = load_node_params(base_config)
+    for node, values in overrides.items():
+        params.setdefault(node, {}).update(values)
+    return params
+
+
+def run_dir(root: Path, run: GraphRun) -> Path:
+    """Where a run's parameters, bag, log and results live."""
+    return root / "runs" / run.name
+
+
+def bag_path(root: Path, run: GraphRun) -> Path:
+    """The run's bag directory."""
+    return run_dir(root, run) / "bag"
+
+
+def is_complete(root: Path, run: GraphRun) -> bool:
+    """True when the run finished and its bag is closed."""
+    d = run_dir(root, run)
+    return (d / COMPLETE).is_file() and bag_path(root, run).is_dir()
+
+
+def _params_yaml(run: GraphRun, bag: Path) -> str:
+    params = {k: dict(v) for k, v in run.params.items()}
+    add_recorder(params, str(bag), "mcap")
+    doc = {"/**" if k == "/**" else k: {"ros__parameters": v} for k, v in params.items()}
+    return yaml.safe_dump(doc, sort_keys=False)
+
+
+def execute(root: Path, run: GraphRun, domain_id: int, timeout_s: float) -> float:
+    """Run ``run`` through the node graph unless it is complete; returns the wall time (s).
+
+    Raises ``RuntimeError`` with the end of the launch log when the graph fails.
+    """
+    d = run_dir(root, run)
+    if is_complete(root, run):
+        return 0.0
+    if d.exists():
+        shutil.rmtree(d)  # an interrupted run: its bag may be open or short
+    d.mkdir(parents=True)
+    bag = bag_path(root, run)
+    (d / "params.yaml").write_text(_params_yaml(run, bag), encoding="utf-8")
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id))
+    env.pop("ROS_STATIC_PEERS", None)
+    launcher = str(Path(sys.executable).parent / "haptic-launch")
+    t0 = time.monotonic()
+    with open(d / "launch.log", "w", encoding="utf-8") as log:
+        proc = subprocess.Popen(
+            [launcher, str(d / "params.yaml"), "--network", "localhost"],
+            env=env,
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
+        try:
+            code = proc.wait(timeout_s)
+        except subprocess.TimeoutExpired:
+            proc.send_signal(2)
+            try:
+                proc.wait(30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+            code = -1
+    wall = time.monotonic() - t0
+    if code != 0:
+        tail = (d / "launch.log").read_text(encoding="utf-8")[-3000:]
+        raise RuntimeError(f"run {run.name} failed (code {code}) after {wall:.0f} s:\n{tail}")
+    (d / COMPLETE).write_text(json.dumps({"wall_s": wall}), encoding="utf-8")
+    return wall
+
+
+def execute_all(
+    root: Path,
+    runs: Iterable[GraphRun],
+    workers: int,
+    rtf_guess: float = 1.0,
+    progress: Callable[[str], None] | None = None,
+) -> dict[str, float]:
+    """Execute the runs, ``workers`` at a time on separate domains; {name: wall time}."""
+    runs = list(runs)
+    todo = [r for r in runs if not is_complete(root, r)]
+    say = progress or (lambda _s: None)
+    done = len(runs) - len(todo)
+    if done:
+        say(f"{done} of {len(runs)} runs already recorded (resuming)")
+    n_workers = max(workers, 1)
+    domains: queue.Queue[int] = queue.Queue()
+    for d in random.sample(range(101, 231), n_workers):  # one domain per concurrent run
+        domains.put(d)
+    walls: dict[str, float] = {}
+    counter = {"n": done}
+    lock = threading.Lock()
+
+    def one(run: GraphRun) -> None:
+        budget = 120.0 + 4.0 * run.duration_s / max(rtf_guess, 0.1)
+        domain = domains.get()
+        try:
+            wall = execute(root, run, domain, budget)
+        finally:
+            domains.put(domain)
+        with lock:
+            walls[run.name] = wall
+            counter["n"] += 1
+            say(
+                f"[{counter['n']:>3}/{len(runs)}] {run.label or run.name}: "
+                f"{run.duration_s:g} s simulated in {wall:.1f} s"
+            )
+
+    with ThreadPoolExecutor(n_workers) as ex:
+        list(ex.map(one, todo))
+    return walls
