@@ -21,7 +21,9 @@ from rosgraph import Collector, isolated_env, restart, start_nodes
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
-TIMEOUT_S = 0.005  # the device's command_timeout_s default
+# the watchdog trips at the first tick after command_timeout_s (the device's default) without a
+# command; the zero effort shows in the sample after that tick: at most the timeout + 2 periods
+TIMEOUT_S = 0.005
 PERIOD_S = 0.001
 
 
@@ -105,7 +107,7 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         while held + 1 <= nonzero[-1] and e[nonzero[-1] - held - 1] == e[nonzero[-1]]:
             held += 1
         latency = stamps[first_zero] - stamps[nonzero[-1] - held]
-        assert latency <= TIMEOUT_S + 2 * PERIOD_S, f"{latency * 1e3:.1f} ms"
+        assert latency <= TIMEOUT_S + 2 * PERIOD_S + 1e-9, f"{latency * 1e3:.1f} ms"
         deadline = time.monotonic() + 5  # diagnostics come once a second
         while time.monotonic() < deadline:
             statuses = diagnostics_after(col, t_kill)

@@ -23,6 +23,8 @@ from rosgraph import Process, isolated_env
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
 BIN = Path(sys.executable).parent
+# the watchdog trips at the first tick after command_timeout_s without a command; the zero effort
+# shows in the sample after that tick: the held effort lasts at most the timeout + 2 periods
 TIMEOUT_S, PERIOD_S = 0.005, 0.001
 
 
@@ -142,7 +144,7 @@ def test_loop_across_two_hosts_and_a_link_failure(hosts, root, tmp_path) -> None
         while held + 1 <= last and ew[last - held - 1] == ew[last]:
             held += 1
         latency = sw[last + 1] - sw[last - held]
-        assert latency <= TIMEOUT_S + 2 * PERIOD_S, f"{latency * 1e3:.1f} ms"
+        assert latency <= TIMEOUT_S + 2 * PERIOD_S + 1e-9, f"{latency * 1e3:.1f} ms"
     finally:
         for p in reversed(procs):
             p.stop()
