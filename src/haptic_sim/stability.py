@@ -31,9 +31,8 @@ from concurrent.futures import Executor, ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import signal
 
-from haptic_dob.analysis.vibration import envelope_growth
+from haptic_dob.analysis.vibration import perturbation_response
 from haptic_dob.control import ControlMode, ImpedanceLaw
 from haptic_dob.environment import VirtualWall
 from haptic_dob.observer import ObserverSettings
@@ -159,22 +158,16 @@ def growth_at(protocol: StabilityProtocol, base: SessionConfig, stiffness: float
     """Run the protocol at one stiffness and measure the envelope growth."""
     cfg = protocol.session(base, stiffness)
     res = run_session(cfg)
-    fs = cfg.loop.rate_hz
-    depth = protocol.push_n / stiffness
-    baseline = float(np.dot(cfg.wall.position, cfg.wall.normal)) + depth  # along the slide axis
-    x = res.x_true * float(np.dot(cfg.model.axis, cfg.wall.normal))
-    i0 = round(protocol.pulse_at_s * fs)
-    pre = x[round((protocol.pulse_at_s - 0.2) * fs) : i0]
-    pre_amp = float(np.max(np.abs(pre - baseline)))
-    if pre_amp > 0.5 * depth:
-        _, p = signal.periodogram(pre - np.mean(pre), fs=fs)
-        freq = float(np.argmax(p[1:]) + 1) * fs / pre.size
-        return StabilityPoint(
-            float(stiffness), math.nan, freq, pre_amp, vibrating_before_pulse=True
-        )
-    start = i0 + round(protocol.pulse_s * fs)
-    g = envelope_growth(x[start:], fs, baseline=baseline, stop_amplitude=0.5 * depth)
-    return StabilityPoint(float(stiffness), g.rate_per_s, g.frequency_hz, g.amplitude_end)
+    normal = np.asarray(cfg.wall.normal)
+    depth = res.x_true * float(np.dot(cfg.model.axis, normal)) - float(
+        np.dot(cfg.wall.position, normal)
+    )
+    r = perturbation_response(
+        depth, cfg.loop.rate_hz, protocol.pulse_at_s, protocol.pulse_s, protocol.push_n / stiffness
+    )
+    return StabilityPoint(
+        float(stiffness), r.growth_per_s, r.frequency_hz, r.amplitude_m, r.vibrating_before_pulse
+    )
 
 
 def sweep(

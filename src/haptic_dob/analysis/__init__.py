@@ -8,16 +8,23 @@ from haptic_dob.analysis.transparency import (
     mass_damper_band_edge_hz,
     transparency,
 )
-from haptic_dob.analysis.vibration import Growth, envelope_growth
+from haptic_dob.analysis.vibration import (
+    Growth,
+    PerturbationResponse,
+    envelope_growth,
+    perturbation_response,
+)
 
 __all__ = [
     "EnergyResult",
     "Growth",
+    "PerturbationResponse",
     "TransparencyResult",
     "band_edge",
     "envelope_growth",
     "h1_impedance",
     "mass_damper_band_edge_hz",
     "passivity_observer",
+    "perturbation_response",
     "transparency",
 ]

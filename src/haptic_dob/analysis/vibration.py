@@ -72,3 +72,50 @@ def envelope_growth(
     f, p = signal.periodogram(d[lo:hi], fs=fs, detrend="linear")
     freq = float(f[int(np.argmax(p[1:])) + 1]) if p.size > 1 else math.nan
     return Growth(slope, freq, float(seg[0]), float(seg[-1]), seg.size / fs)
+
+
+@dataclass(frozen=True)
+class PerturbationResponse:
+    """How a wall answers a force pulse while a hand pushes steadily into it."""
+
+    growth_per_s: float  # envelope growth after the pulse (1/s); NaN if vibrating before it
+    frequency_hz: float
+    amplitude_m: float  # envelope at the end of the fit (or the swing before the pulse)
+    vibrating_before_pulse: bool  # the contact itself already started a sustained oscillation
+
+    @property
+    def vibrates(self) -> bool:
+        """True when the oscillation grows (or was sustained before the pulse)."""
+        return bool(self.vibrating_before_pulse or self.growth_per_s > 0.0)
+
+
+def perturbation_response(
+    depth_m: ArrayLike,
+    fs_hz: float,
+    pulse_at_s: float,
+    pulse_s: float,
+    static_depth_m: float,
+) -> PerturbationResponse:
+    """Growth of the oscillation a pulse starts in a steadily pushed wall (the onset protocol).
+
+    ``depth_m`` is the penetration into the wall over time (m, from the start of the session,
+    > 0 inside); ``static_depth_m`` the equilibrium penetration (push / K). The growth is fitted
+    from the end of the pulse about the equilibrium and stops where the oscillation reaches half
+    the equilibrium depth (contact is about to be lost). A swing of that size already in the
+    0.2 s before the pulse means the contact itself started a sustained oscillation: the wall
+    vibrates and its growth is not measured (NaN).
+    """
+    fs = positive("fs_hz", fs_hz)
+    d = np.asarray(depth_m, dtype=np.float64).reshape(-1)
+    depth = positive("static_depth_m", static_depth_m)
+    i0 = round(pulse_at_s * fs)
+    pre = d[max(0, round((pulse_at_s - 0.2) * fs)) : i0]
+    start = i0 + round(pulse_s * fs)
+    if pre.size < 16 or d.size - start < 16:
+        raise ValueError("the record must hold 0.2 s before the pulse and some time after it")
+    pre_amp = float(np.max(np.abs(pre - depth)))
+    if pre_amp > 0.5 * depth:
+        f, p = signal.periodogram(pre - np.mean(pre), fs=fs)
+        return PerturbationResponse(math.nan, float(f[int(np.argmax(p[1:])) + 1]), pre_amp, True)
+    g = envelope_growth(d[start:], fs, baseline=depth, stop_amplitude=0.5 * depth)
+    return PerturbationResponse(g.rate_per_s, g.frequency_hz, g.amplitude_end, False)

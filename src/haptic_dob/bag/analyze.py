@@ -27,6 +27,7 @@ from haptic_dob.analysis.transparency import (
     TransparencyResult,
     transparency,
 )
+from haptic_dob.analysis.vibration import PerturbationResponse, perturbation_response
 from haptic_dob.bag.errors import BagError
 from haptic_dob.bag.oscillation import Oscillation, OscillationSettings, oscillation
 from haptic_dob.bag.reader import AXES, JOINT_STATE, Selection, read_bag
@@ -123,6 +124,7 @@ class SegmentResult:
     figures: Figures
     record: Record = field(repr=False)
     window: slice = field(repr=False)
+    perturbation: PerturbationResponse | None = None  # push-and-hold sessions: the pulse's answer
 
     @property
     def controller(self) -> str:
@@ -181,6 +183,12 @@ class SegmentResult:
                 self.analysed_from_s + en.t_max_active_s if en.max_active_j > 0 else None
             ),
             "final_energy_j": en.final_j,
+            "perturbation_growth_per_s": None
+            if self.perturbation is None
+            else _num(self.perturbation.growth_per_s),
+            "perturbation_vibrates": None
+            if self.perturbation is None
+            else self.perturbation.vibrates,
             "missing_samples": self.record.missing,
             "sample_rate_hz": self.record.fs_hz,
             "parameters": seg.params,
@@ -266,6 +274,7 @@ def analyze_bag(
             st.segment_s,
             st.oscillation,
         )
+        pulse = _pulse_response(seg, rec, k, p_axis, n_axis, fs)
         results.append(
             SegmentResult(
                 bag=data.path,
@@ -280,6 +289,7 @@ def analyze_bag(
                 figures=figs,
                 record=rec,
                 window=window,
+                perturbation=pulse,
             )
         )
     if all(r.figures.transparency is None for r in results):
@@ -304,6 +314,43 @@ def analyze_bag(
         rec.velocity_source,
         results,
     )
+
+
+def _pulse_response(
+    seg: Segment,
+    rec: Record,
+    k: float | None,
+    p_axis: float | None,
+    n_axis: float | None,
+    fs: float,
+) -> PerturbationResponse | None:
+    """The onset protocol's answer to its force pulse, for a push-and-hold session segment.
+
+    The recorded device parameters say whether the hand pushed and held with a pulse; the push
+    comes from the reference offset through the grip and wall compliances (as the protocol set
+    it), and the penetration from the recorded motion (the whole segment, no settling left out).
+    """
+    dev = seg.params.get("device_node", {})
+    if dev.get("hand.behaviour") != "push_hold" or not dev.get("hand.perturbation_n"):
+        return None
+    if not k or p_axis is None or not n_axis or seg.index != 0:
+        return None
+    k_h = float(dev.get("hand.stiffness_n_per_m") or 0.0)
+    if k_h <= 0.0:
+        return None
+    push = float(dev["hand.offset_m"]) / (1.0 / k + 1.0 / k_h)
+    depth = (rec.x[seg.start : seg.stop] - p_axis) * n_axis
+    start_s = float(rec.time_s(seg.start))
+    try:
+        return perturbation_response(
+            depth,
+            fs,
+            float(dev.get("hand.perturbation_at_s", 0.0)) - start_s,
+            float(dev.get("hand.perturbation_s", 0.0)),
+            push / k,
+        )
+    except ValueError:
+        return None
 
 
 def _problem_text(r: SegmentResult, coordinate: str) -> str:

@@ -28,11 +28,23 @@ import numpy as np
 
 from haptic_dob.bag.reader import ParamEvent
 
-#: node name -> the parameters that define a segment
+#: node name -> the parameters that define a segment (the device's are read-only: they never
+#: split a session, they label it -- the hand's protocol, the plant's friction, the seed)
 RELEVANT: dict[str, tuple[str, ...]] = {
     "controller_node": ("mode", "kf", "max_force_n"),
     "environment_node": ("stiffness_n_per_m", "damping_n_s_per_m", "position", "normal"),
     "observer_node": ("gain", "output_limit"),
+    "device_node": (
+        "clock_mode",
+        "seed",
+        "slide.coulomb_n",
+        "hand.behaviour",
+        "hand.stiffness_n_per_m",
+        "hand.offset_m",
+        "hand.perturbation_n",
+        "hand.perturbation_at_s",
+        "hand.perturbation_s",
+    ),
 }
 
 Params = dict[str, dict[str, Any]]  # node name -> parameter -> value
