@@ -1,0 +1,48 @@
+"""The linear discrete model of the loop: the passivity bounds, and DOB against CL."""
+
+from __future__ import annotations
+
+import pytest
+
+from haptic_dob.analysis.linear_loop import linear_onset, spectral_radius
+
+
+@pytest.mark.parametrize("kf", [0.0, 1.0, 2.0, 25.0])
+def test_ol_and_cl_onsets_are_the_sampled_spring_bound(kf: float) -> None:
+    """An ideal force sensor makes the loop a sampled spring (1 + Kf) K: K (1+Kf) < 2 b / T."""
+    bound = 2 * 1.272 / 1e-3 / (1 + kf)
+    onset = linear_onset(kf, "OL" if kf == 0 else "CL")
+    assert onset == pytest.approx(bound, rel=0.01)
+
+
+def test_dob_is_less_stable_than_cl_and_more_so_for_a_fast_observer() -> None:
+    cl = linear_onset(1.0, "CL")
+    slow, fast = linear_onset(1.0, "DOB", gain=2.0), linear_onset(1.0, "DOB", gain=41.6)
+    assert fast < cl
+    assert fast < slow <= cl * 1.02
+
+
+def test_dob_kf_100_is_unstable_at_any_stiffness_with_the_default_observer() -> None:
+    assert linear_onset(100.0, "DOB", gain=41.6) == 0.0
+    assert spectral_radius(0.0, 100.0, "DOB", 41.6, 0.416, 1.272, 1e-3) > 1.0
+
+
+@pytest.mark.parametrize(("mode", "kf"), [("CL", 2.0), ("DOB", 1.0), ("DOB", 2.0)])
+def test_the_model_matches_the_simulated_onset(mode: str, kf: float) -> None:
+    """The protocol's batch onset (encoder, sensor noise, no Coulomb, the 20 N/m grip) is the
+    linear model's with the same grip, within 3 %; the grip matters (DOB Kf=1: 775 -> 661 N/m)."""
+    from haptic_sim.session import SessionConfig
+    from haptic_sim.stability import StabilityProtocol, law_for, sweep
+
+    grip = StabilityProtocol().grip_n_per_m
+    lin = linear_onset(kf, mode, hand_stiffness=grip)
+    base = SessionConfig().replace(law=law_for(mode, kf))
+    result = sweep([lin * 0.9, lin * 0.97, lin * 1.03, lin * 1.1], base)
+    assert result.onset_stiffness_n_per_m == pytest.approx(lin, rel=0.03)
+
+
+def test_bad_arguments() -> None:
+    with pytest.raises(ValueError, match="mode"):
+        spectral_radius(800.0, 1.0, "PID", 41.6, 0.416, 1.272, 1e-3)
+    with pytest.raises(ValueError, match="gain"):
+        spectral_radius(800.0, 1.0, "DOB", 0.0, 0.416, 1.272, 1e-3)
