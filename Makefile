@@ -1,6 +1,7 @@
 # haptic_dob: the two commands of the README, plus a few helpers.
-#   make demo   create .venv, install, run the default simulated virtual-wall session
-#   make test   install if needed, run the whole test suite
+#   make demo       create .venv, install, run OL / CL / DOB at 800 N/m through the node graph
+#   make test       install if needed, run the whole test suite
+#   make reproduce  the thesis's chapters 6 and 7 through the node graph, report in report/
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -8,10 +9,13 @@ STAMP  := $(VENV)/.installed
 # files copied into the environment at install time (ament index, package.xml, shims, config)
 INSTALLED_DATA := $(shell find ros config -type f 2>/dev/null)
 
-.PHONY: demo test install lint bench lock clean
+.PHONY: demo test reproduce install lint bench lock clean
 
 demo: $(STAMP)
-	@$(BIN)/haptic-demo
+	@$(BIN)/haptic-experiment --quick --out build/demo
+
+reproduce: $(STAMP)
+	@$(BIN)/haptic-experiment --out report
 
 test: $(STAMP)
 	@$(BIN)/python -m pytest -q -p no:cacheprovider

@@ -5,11 +5,13 @@ recorder. ``execute`` writes ``params.yaml`` into the run's directory, starts th
 ``haptic-launch`` on a domain of its own (localhost discovery), lets the device finish its
 ``duration_s`` (the recorder holds the loop back while it lags, and the device waits for it to
 write the last sample), and marks the run ``complete``. A complete run is never run again: an
-interrupted experiment resumes from the bags already written.
+interrupted experiment resumes from the bags already written (a run whose parameters changed
+runs again).
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import queue
@@ -67,9 +69,21 @@ def bag_path(root: Path, run: GraphRun) -> Path:
 
 
 def is_complete(root: Path, run: GraphRun) -> bool:
-    """True when the run finished and its bag is closed."""
+    """True when the run finished, its bag is closed, and it ran with these very parameters."""
     d = run_dir(root, run)
-    return (d / COMPLETE).is_file() and bag_path(root, run).is_dir()
+    if not bag_path(root, run).is_dir():
+        return False
+    try:
+        marker = json.loads((d / COMPLETE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(marker, dict) and marker.get("params_digest") == params_digest(run)
+
+
+def params_digest(run: GraphRun) -> str:
+    """A digest of the run's node parameters (what decides whether a recorded run still holds)."""
+    text = json.dumps(run.params, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 def _params_yaml(run: GraphRun, bag: Path) -> str:
@@ -118,7 +132,8 @@ def execute(root: Path, run: GraphRun, domain_id: int, timeout_s: float) -> floa
     if code != 0:
         tail = (d / "launch.log").read_text(encoding="utf-8")[-3000:]
         raise RuntimeError(f"run {run.name} failed (code {code}) after {wall:.0f} s:\n{tail}")
-    (d / COMPLETE).write_text(json.dumps({"wall_s": wall}), encoding="utf-8")
+    marker = {"wall_s": wall, "params_digest": params_digest(run)}
+    (d / COMPLETE).write_text(json.dumps(marker), encoding="utf-8")
     return wall
 
 

@@ -27,7 +27,7 @@ CH6_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 10
 #: the thesis's walls (800-3200 N/m) and points around the OL and CL bounds (2544, 848 N/m)
 CH6_WALLS: dict[str, list[float]] = {
     "OL": [800.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0],
-    "CL": [600.0, 800.0, 1000.0, 1200.0, 1600.0, 2400.0, 3200.0],
+    "CL": [600.0, 800.0, 900.0, 1000.0, 1200.0, 1600.0, 2400.0, 3200.0],
     "DOB": [800.0, 1600.0, 2400.0, 3200.0],
 }
 RECORDED = ["ee_pose", "ee_twist", "wrench_measured", "/parameter_events"]

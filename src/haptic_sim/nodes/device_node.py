@@ -59,6 +59,7 @@ from haptic_msgs_py.topics import (
 )
 from haptic_sim.device import DeviceSample
 from haptic_sim.factory import build_device, simulation_specs
+from haptic_sim.latency import LatencyHistogram
 
 DEFAULT_WAIT_FOR = ["environment_node", "observer_node", "controller_node"]
 STARTUP_RESEND_S = 0.5
@@ -202,7 +203,7 @@ class DeviceNode(LoopNode):
         self._on_time = 0
         self._late = 0
         self._missed_ticks = 0
-        self._latency_s: list[float] = []
+        self._latency = LatencyHistogram()  # constant memory however long it runs
         self._command_k = -1
         self.diagnostics = Diagnostics(self, self._report)
         mode = "lockstep" if self.lockstep else f"realtime at {v['rate_hz']:g} Hz"
@@ -305,7 +306,7 @@ class DeviceNode(LoopNode):
         if stamp == current and self.device.k != self._command_k:
             self._command_k = self.device.k
             self._on_time += 1
-            self._latency_s.append(now - self._sent_s)
+            self._latency.add(now - self._sent_s)
 
     def _on_progress(self, msg: Any) -> None:
         st = msg.stamp
@@ -462,7 +463,6 @@ class DeviceNode(LoopNode):
     # --- end -------------------------------------------------------------------------------
     def stats(self) -> dict[str, Any]:
         """Real-time cycle statistics so far."""
-        lat = np.array(self._latency_s) if self._latency_s else np.array([np.nan])
         total = self._on_time + self._late
         return {
             "cycles": self.device.k,
@@ -470,8 +470,8 @@ class DeviceNode(LoopNode):
             "commands_late": self._late,
             "on_time_pct": 100.0 * self._on_time / total if total else math.nan,
             "missed_ticks": self._missed_ticks,
-            "latency_p50_ms": float(np.percentile(lat, 50) * 1e3),
-            "latency_p99_ms": float(np.percentile(lat, 99) * 1e3),
+            "latency_p50_ms": self._latency.percentile(50) * 1e3,
+            "latency_p99_ms": self._latency.percentile(99) * 1e3,
             "refused_commands": self.refused,
             "limited_commands": self.limited,
             "watchdog_trips": self.watchdog_trips,

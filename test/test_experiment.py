@@ -1,0 +1,255 @@
+"""``haptic-experiment``: the quick reproduction through the node graph, its report, and its parts.
+
+The quick variant (the demo) records OL, CL Kf=2 and DOB Kf=1 at 800 N/m through the node graph;
+``haptic-analyze`` on its bags must give the report's numbers, and a second run resumes from the
+bags. The rest checks the pieces on their own: the onset interpolation from graph results, the
+acceptance checks, the report's rendering, and the DOB mechanism the report explains.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import time
+
+import pytest
+
+from conftest import tool
+from haptic_sim.experiments import dob, results
+from haptic_sim.experiments.plan import chapter6_runs, chapter7_runs
+from haptic_sim.session import SessionConfig
+from haptic_sim.stability import law_for
+
+
+@pytest.mark.slow
+@pytest.mark.multiprocess
+def test_quick_experiment_runs_through_the_graph_and_haptic_analyze_reproduces_it(
+    tmp_path,
+) -> None:
+    out = tmp_path / "report"
+    t0 = time.monotonic()
+    p = subprocess.run(
+        [tool("haptic-experiment"), "--quick", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=240,
+    )
+    first_wall = time.monotonic() - t0
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "[  3/3]" in p.stdout  # progress while it runs
+    res = json.loads((out / "results.json").read_text())
+    assert {(r["mode"], r["kf"], r["wall"]) for r in res["ch7"]} == {
+        ("OL", 0.0, 800.0),
+        ("CL", 2.0, 800.0),
+        ("DOB", 1.0, 800.0),
+    }
+    report = (out / "report.md").read_text()
+    assert "| OL |" in report and "Table 7.1" in report
+    assert (out / "figures" / "ch7_transparency.png").stat().st_size > 10_000
+    # every number comes from the bag: haptic-analyze on it prints the same figures
+    for row in res["ch7"]:
+        assert row["segments"] == 1 and row["problem"] is None
+        a = subprocess.run(
+            [tool("haptic-analyze"), row["bag"], "--json"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert a.returncode == 0, a.stderr
+        (seg,) = json.loads(a.stdout)
+        assert seg["controller"] == row["mode"] and seg["kf"] == row["kf"]
+        assert seg["stiffness_n_per_m"] == row["wall"]
+        assert seg["bandwidth_hz"] == row["bandwidth_hz"]
+        assert seg["impedance_error_pct"] == row["impedance_error_pct"]
+    # the thesis's ordering at 800 N/m: force feedback widens the band
+    bw = {r["mode"]: r["bandwidth_hz"] for r in res["ch7"]}
+    assert bw["CL"] > bw["OL"] and bw["DOB"] > bw["OL"]
+    # a second run resumes from the bags instead of running the graph again
+    t0 = time.monotonic()
+    again = subprocess.run(
+        [tool("haptic-experiment"), "--quick", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert again.returncode == 0, again.stderr
+    assert "3 of 3 runs already recorded" in again.stdout
+    assert time.monotonic() - t0 < first_wall / 2
+    assert json.loads((out / "results.json").read_text())["ch7"] == res["ch7"]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--parts", "ch7,nope"], "--parts takes a comma-separated subset"),
+        (["--workers", "0"], "--workers must be >= 1"),
+        (["--config", "no_such_config"], "no config 'no_such_config'"),
+    ],
+)
+def test_bad_arguments_get_one_error_line(tmp_path, args, message) -> None:
+    p = subprocess.run(
+        [tool("haptic-experiment"), "--out", str(tmp_path / "r"), *args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert p.returncode == 2
+    assert message in p.stderr and "Traceback" not in p.stderr
+    assert not (tmp_path / "r" / "runs").exists()
+
+
+def test_fresh_refuses_a_directory_that_is_not_an_experiment(tmp_path) -> None:
+    victim = tmp_path / "precious"
+    victim.mkdir()
+    (victim / "thesis.tex").write_text("keep me")
+    p = subprocess.run(
+        [tool("haptic-experiment"), "--quick", "--fresh", "--out", str(victim)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert p.returncode == 2 and "does not look like an experiment directory" in p.stderr
+    assert (victim / "thesis.tex").read_text() == "keep me"
+
+
+def test_the_plan_holds_the_thesis_cells(root) -> None:
+    config = root / "config" / "slide_sim.yaml"
+    ch7 = chapter7_runs(config)
+    assert len(ch7) == 16 and {r.duration_s for r in ch7} == {40.0}
+    assert len({r.name for r in ch7}) == 16
+    for r in ch7:  # OL and CL leave the observer out; DOB waits for it
+        has_observer = "observer_node" in r.params
+        assert has_observer == (r.meta["mode"] == "DOB")
+        assert ("observer_node" in r.params["device_node"]["wait_for"]) == has_observer
+    ch6 = chapter6_runs(config)
+    walls = {m: sorted(r.meta["wall"] for r in ch6 if r.meta["mode"] == m) for m in ["OL", "CL"]}
+    # the walls bracket the bounds 2544 (OL) and 848 (CL Kf=2) N/m
+    assert any(w < 2544 for w in walls["OL"]) and any(w > 2544 for w in walls["OL"])
+    assert any(w < 848 for w in walls["CL"]) and any(w > 848 for w in walls["CL"])
+    assert all(r.params["/**"]["slide.coulomb_n"] == 0.0 for r in ch6)
+
+
+def _row(mode: str, kf: float, wall: float, growth: float | None, vib: bool) -> dict:
+    return {
+        "mode": mode,
+        "kf": kf,
+        "wall": wall,
+        "perturbation_growth_per_s": growth,
+        "perturbation_vibrates": vib,
+    }
+
+
+def test_ch6_onset_is_the_interpolated_zero_crossing_of_the_growth_rate() -> None:
+    rows = [
+        _row("OL", 0.0, 2800.0, 0.2, True),
+        _row("OL", 0.0, 2400.0, -0.1, False),
+        _row("CL", 2.0, 800.0, None, True),  # already vibrating before the pulse
+        _row("DOB", 100.0, 800.0, -0.5, False),
+    ]
+    on = results.ch6_onsets(rows)
+    assert on["OL"]["onset_n_per_m"] == pytest.approx(2400.0 + 400.0 / 3.0)
+    assert [p["wall"] for p in on["OL"]["points"]] == [2400.0, 2800.0]
+    assert on["CL Kf=2"]["onset_n_per_m"] == 800.0 and on["CL Kf=2"]["first_point_vibrates"]
+    assert on["DOB Kf=100"]["onset_n_per_m"] is None
+    checks = {text.split(" onset")[0]: ok for text, ok in results.ch6_checks(on, 1.272, 1000.0)}
+    assert checks == {"OL": True, "CL Kf=2": False}  # OL 2533 vs 2544; CL below the range
+
+
+def test_ch7_checks_compare_with_the_thesis_and_with_ol() -> None:
+    rows = [
+        {"mode": "OL", "kf": 0.0, "wall": 800.0, "bandwidth_hz": 4.5},  # 3.8 Hz +- 15 %: no
+        {"mode": "OL", "kf": 0.0, "wall": 1600.0, "bandwidth_hz": 5.0},
+        {"mode": "CL", "kf": 2.0, "wall": 800.0, "bandwidth_hz": 5.0},
+        {"mode": "DOB", "kf": 1.0, "wall": 800.0, "bandwidth_hz": 4.0},
+    ]
+    checks = results.ch7_checks(rows)
+    assert [ok for _, ok in checks] == [False, True, True, False]
+
+
+def test_report_renders_every_section(tmp_path) -> None:
+    from haptic_sim.experiments import report
+
+    base = SessionConfig()
+    res = {
+        "config": "slide_sim",
+        "quick": False,
+        "seed": 0,
+        "parts": ["ch7", "ch6", "dob"],
+        "ch7": [
+            {
+                "mode": "OL",
+                "kf": 0.0,
+                "wall": w,
+                "bandwidth_hz": 1.0 + w / 1000.0,
+                "impedance_error_pct": 20.0,
+                "band_limited_by_fmax": False,
+                "vibrating": False,
+            }
+            for w in (80.0, 800.0)
+        ],
+        "ch6": [_row("OL", 0.0, 2400.0, -0.1, False), _row("OL", 0.0, 2800.0, 0.2, True)],
+        "dob": {
+            "kick": [
+                {
+                    "stiffness_n_per_m": w,
+                    "gain": 2.0,
+                    "coulomb_n": 0.24,
+                    "residual_rms_m": r,
+                    "frequency_hz": 40.0,
+                    "vibrates": r > dob.VIBRATION_RMS_M,
+                }
+                for w, r in zip(dob.WALLS, [0, 0, 0, 0, 7e-5, 9e-5], strict=True)
+            ],
+            "first_vibrating": [{"gain": 2.0, "coulomb_n": 0.24, "wall": 3200.0}],
+            "linear": [
+                {"kf": 100.0, "gain": 2.0, "dob_onset_n_per_m": 0.0, "cl_onset_n_per_m": 26.0}
+            ],
+            "bandwidth_vs_gain": [{"gain": 2.0, "bandwidth_hz": 1.2, "impedance_error_pct": 48.0}],
+        },
+        "timing_s": {"total": 1.0},
+    }
+    res["ch6_onsets"] = results.ch6_onsets(res["ch6"])
+    res["ch6_checks"] = results.ch6_checks(res["ch6_onsets"], 1.272, 1000.0)
+    res["ch7_checks"] = results.ch7_checks(res["ch7"])
+    path = report.write(tmp_path, res, base)
+    text = path.read_text()
+    assert "| OL | 1.08 / 1.3 | 1.80 / 3.8 |" in text  # simulation beside thesis Table 7.1
+    assert "| OL | 2533 | 2544 | 2400 |" in text
+    assert "first wall that keeps vibrating is 3200 N/m, as in the thesis" in " ".join(text.split())
+    assert "- [x] OL onset through the graph 2533 N/m within +-5 % of 2544 N/m" in text
+    for fig in ("ch7_transparency.png", "ch6_onsets.png", "dob_kick_grid.png"):
+        assert (tmp_path / "figures" / fig).is_file()
+
+
+def test_dob_stays_quiet_with_friction_and_a_slow_observer_and_vibrates_without() -> None:
+    """The mechanism of the report's DOB section, cell by cell (DOB Kf = 100, c = 2)."""
+    dob100 = SessionConfig().replace(law=law_for("DOB", 100.0))
+    p = dob.KickProtocol()
+    quiet = dob.kick_point(p, dob100, 1600.0, 2.0, 0.24)
+    chatter = dob.kick_point(p, dob100, 1600.0, 2.0, 0.0)
+    loud = dob.kick_point(p, dob100, 3200.0, 2.0, 0.24)
+    assert not quiet.vibrates, quiet
+    assert chatter.vibrates and chatter.residual_rms_m > 10 * dob.VIBRATION_RMS_M, chatter
+    assert loud.vibrates, loud
+    assert math.isfinite(loud.frequency_hz) and 20.0 < loud.frequency_hz < 100.0
+
+
+def test_a_recorded_run_counts_only_with_the_same_parameters(tmp_path) -> None:
+    from haptic_sim.experiments.graph_runs import (
+        COMPLETE,
+        GraphRun,
+        bag_path,
+        is_complete,
+        params_digest,
+        run_dir,
+    )
+
+    run = GraphRun("r", {"device_node": {"duration_s": 1.0}})
+    bag_path(tmp_path, run).mkdir(parents=True)
+    assert not is_complete(tmp_path, run)  # interrupted: no marker
+    marker = {"wall_s": 1.0, "params_digest": params_digest(run)}
+    (run_dir(tmp_path, run) / COMPLETE).write_text(json.dumps(marker))
+    assert is_complete(tmp_path, run)
+    changed = GraphRun("r", {"device_node": {"duration_s": 2.0}})
+    assert not is_complete(tmp_path, changed)
