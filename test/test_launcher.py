@@ -179,3 +179,22 @@ def test_record_option_writes_a_complete_bag(root, tmp_path) -> None:
     assert seg["duration_s"] == pytest.approx(3.0, abs=0.002)
     again = launch_cli(str(root / "config" / "slide_sim.yaml"), "--record", str(bag))
     assert again.returncode == 2 and "exists already" in again.stderr
+
+
+@pytest.mark.parametrize(
+    ("given", "expected"),
+    [("", ""), ("slide1", "/slide1"), ("/slide1", "/slide1"), ("lab/slide_1/", "/lab/slide_1")],
+)
+def test_namespace_is_made_absolute(given: str, expected: str) -> None:
+    from haptic_dob.launcher import normalize_namespace
+
+    assert normalize_namespace(given) == expected
+
+
+@pytest.mark.parametrize("bad", ["1slide", "sl ide", "a//b", "a-b"])
+def test_invalid_namespace_is_refused(bad: str) -> None:
+    from haptic_dob.cli import CliError
+    from haptic_dob.launcher import normalize_namespace
+
+    with pytest.raises(CliError, match="not a valid ROS namespace"):
+        normalize_namespace(bad)

@@ -19,6 +19,7 @@ on another (see the README's lab-network section).
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -275,6 +276,20 @@ def compose(specs: list[NodeSpec], executor: str | None) -> int:
     )
 
 
+def normalize_namespace(namespace: str) -> str:
+    """``slide1`` -> ``/slide1`` (ROS wants it absolute); ``CliError`` for an invalid name."""
+    ns = namespace.strip()
+    if not ns:
+        return ""
+    ns = "/" + ns.strip("/")
+    if not re.fullmatch(r"(/[A-Za-z_][A-Za-z0-9_]*)+", ns):
+        raise CliError(
+            f"--namespace {namespace!r} is not a valid ROS namespace (letters, digits and _ "
+            "separated by /, each part not starting with a digit)"
+        )
+    return ns
+
+
 def command(
     config: str,
     namespace: str,
@@ -292,6 +307,7 @@ def command(
     """Resolve, plan and run; raises ``CliError`` on bad input."""
     import tempfile
 
+    namespace = normalize_namespace(namespace)
     path = resolve_config(config)
     params = resolved_params(path, parse_sets(sets))
     if record:

@@ -156,10 +156,10 @@ def plot_ch6(res: dict, path: Path, b: float, rate_hz: float) -> None:
             label=ctl,
         )
         vib = [p["wall"] for p in e["points"] if p["growth_per_s"] is None]
-        if vib:
+        if vib:  # drawn just above zero, one row per controller so none hides another
             ax.plot(
                 vib,
-                [0.0] * len(vib),
+                [0.1 * (i + 1)] * len(vib),
                 "v",
                 color=f"C{i}",
                 ms=9,

@@ -96,8 +96,9 @@ def device_node_specs() -> list[ParamSpec]:
         *simulation_specs(),
         ParamSpec(
             "lockstep_timeout_s",
-            2.0,
-            "lockstep: warn and re-send a sample after this long without its command",
+            0.5,
+            "lockstep: warn and re-send a sample after this long without its command (a "
+            "best-effort input can drop a sample on a loaded machine)",
             "s",
             0.01,
             3600.0,
