@@ -17,12 +17,13 @@ import os
 import queue
 import random
 import shutil
+import signal
 import subprocess
 import sys
 import threading
 import time
 from collections.abc import Callable, Iterable
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -93,10 +94,38 @@ def _params_yaml(run: GraphRun, bag: Path) -> str:
     return yaml.safe_dump(doc, sort_keys=False)
 
 
-def execute(root: Path, run: GraphRun, domain_id: int, timeout_s: float) -> float:
+class Stopper:
+    """Launch processes alive now, so that Ctrl-C or a failed run stops every one of them."""
+
+    def __init__(self) -> None:
+        self.stopping = threading.Event()
+        self._live: set[subprocess.Popen] = set()
+        self._lock = threading.Lock()
+
+    def add(self, proc: subprocess.Popen) -> None:
+        with self._lock:
+            self._live.add(proc)
+        if self.stopping.is_set():
+            proc.send_signal(signal.SIGINT)
+
+    def discard(self, proc: subprocess.Popen) -> None:
+        with self._lock:
+            self._live.discard(proc)
+
+    def stop(self) -> None:
+        """Ask every live launch to stop (SIGINT: the launcher stops its nodes cleanly)."""
+        self.stopping.set()
+        with self._lock:
+            for proc in self._live:
+                proc.send_signal(signal.SIGINT)
+
+
+def execute(
+    root: Path, run: GraphRun, domain_id: int, timeout_s: float, stopper: Stopper | None = None
+) -> float:
     """Run ``run`` through the node graph unless it is complete; returns the wall time (s).
 
-    Raises ``RuntimeError`` with the end of the launch log when the graph fails.
+    Raises ``RuntimeError`` with the end of the launch log when the graph fails (or was stopped).
     """
     d = run_dir(root, run)
     if is_complete(root, run):
@@ -118,16 +147,21 @@ def execute(root: Path, run: GraphRun, domain_id: int, timeout_s: float) -> floa
             stderr=subprocess.STDOUT,
             start_new_session=True,
         )
+        if stopper is not None:
+            stopper.add(proc)
         try:
             code = proc.wait(timeout_s)
         except subprocess.TimeoutExpired:
-            proc.send_signal(2)
+            proc.send_signal(signal.SIGINT)
             try:
                 proc.wait(30)
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
             code = -1
+        finally:
+            if stopper is not None:
+                stopper.discard(proc)
     wall = time.monotonic() - t0
     if code != 0:
         tail = (d / "launch.log").read_text(encoding="utf-8")[-3000:]
@@ -159,11 +193,13 @@ def execute_all(
     counter = {"n": done}
     lock = threading.Lock()
 
-    def one(run: GraphRun) -> None:
+    def one(run: GraphRun, stopper: Stopper) -> None:
+        if stopper.stopping.is_set():
+            return
         budget = 120.0 + 4.0 * run.duration_s / max(rtf_guess, 0.1)
         domain = domains.get()
         try:
-            wall = execute(root, run, domain, budget)
+            wall = execute(root, run, domain, budget, stopper)
         finally:
             domains.put(domain)
         with lock:
@@ -174,6 +210,17 @@ def execute_all(
                 f"{run.duration_s:g} s simulated in {wall:.1f} s"
             )
 
-    with ThreadPoolExecutor(n_workers) as ex:
-        list(ex.map(one, todo))
+    stopper = Stopper()
+    ex = ThreadPoolExecutor(n_workers)
+    futures = [ex.submit(one, r, stopper) for r in todo]
+    try:
+        for f in as_completed(futures):
+            f.result()
+    except BaseException:  # Ctrl-C or a failed run: stop the others, keep what is complete
+        stopper.stop()
+        for f in futures:
+            f.cancel()
+        ex.shutdown(wait=True)
+        raise
+    ex.shutdown()
     return walls
