@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -232,7 +233,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seed", type=int, default=0, help="seed of the hand motion (default 0)")
     p.add_argument("--fresh", action="store_true", help="delete --out first instead of resuming")
     a = p.parse_args(argv)
+    signal.signal(signal.SIGTERM, _interrupt)  # stop like Ctrl-C: every launch, then exit 130
     return run(lambda: command(a.out, a.config, a.parts, a.quick, a.workers, a.seed, a.fresh))
+
+
+def _interrupt(_signum: int, _frame: object) -> None:
+    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":

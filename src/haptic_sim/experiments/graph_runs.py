@@ -163,6 +163,8 @@ def execute(
             if stopper is not None:
                 stopper.discard(proc)
     wall = time.monotonic() - t0
+    if stopper is not None and stopper.stopping.is_set():
+        raise RuntimeError(f"run {run.name} stopped")  # its bag is short: never marked complete
     if code != 0:
         tail = (d / "launch.log").read_text(encoding="utf-8")[-3000:]
         raise RuntimeError(f"run {run.name} failed (code {code}) after {wall:.0f} s:\n{tail}")
