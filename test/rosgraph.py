@@ -108,7 +108,13 @@ class Collector:
         os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = env["ROS_AUTOMATIC_DISCOVERY_RANGE"]
         self.context = Context()
         rclpy.init(context=self.context, args=[])
-        self.node = rclpy.create_node(name, namespace=namespace or None, context=self.context)
+        # no parameter services: a recorder in the graph has nothing to ask this helper
+        self.node = rclpy.create_node(
+            name,
+            namespace=namespace or None,
+            context=self.context,
+            start_parameter_services=False,
+        )
         from rclpy.qos import QoSProfile, ReliabilityPolicy
 
         from haptic_msgs_py.topics import SESSION_TOPICS
@@ -188,7 +194,9 @@ def set_parameter(env: dict[str, str], node: str, name: str, value: Any, timeout
     try:
         from rcl_interfaces.srv import SetParameters
 
-        n = rclpy.create_node(f"param_client_{random.randint(0, 10**6)}", context=ctx)
+        n = rclpy.create_node(
+            f"param_client_{random.randint(0, 10**6)}", context=ctx, start_parameter_services=False
+        )
         cli = n.create_client(SetParameters, f"/{node.lstrip('/')}/set_parameters")
         if not cli.wait_for_service(timeout_sec=timeout):
             raise TimeoutError(f"/{node}/set_parameters did not appear within {timeout} s")

@@ -5,11 +5,11 @@
   last 2000 samples), the parameter-events profile for ``/parameter_events``, reliable volatile
   for other topics. Bag time is the receive time (wall clock, ns); the analysis times samples by
   their header stamps.
-- Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``,
-  each node given ``snapshot_timeout_s``) as a ``rcl_interfaces/msg/ParameterEvent`` with all
-  parameters in ``new_parameters``, on ``/parameter_events`` beside the live events, so the bag
-  says which stiffness, mode and gains were active at every moment. Nodes that start later are
-  snapshot when they appear.
+- Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``;
+  a node silent for ``snapshot_timeout_s`` is warned about and still asked) as a
+  ``rcl_interfaces/msg/ParameterEvent`` with all parameters in ``new_parameters``, on
+  ``/parameter_events`` beside the live events, so the bag says which stiffness, mode and gains
+  were active at every moment. Nodes that start later are snapshot when they appear.
 - Publishes ``recorder/progress`` (``std_msgs/Header``: the stamp, and this recorder's name in
   ``frame_id`` so a device can follow the slowest of several; reliable, transient local) at
   ``progress_rate_hz``: the newest stamp written, minimum over the stamped topics that are
@@ -114,7 +114,8 @@ def recorder_specs() -> list[ParamSpec]:
         ParamSpec(
             "snapshot_timeout_s",
             2.0,
-            "how long a node gets to answer the parameter snapshot",
+            "warn when a node has not answered the parameter snapshot after this long (it is "
+            "still asked)",
             "s",
             0.1,
             60.0,
@@ -194,6 +195,7 @@ class _Snapshot:
     get_client: Any
     future: Any = None
     names: list[str] | None = None
+    warned: bool = False
 
 
 class RecorderNode(LoopNode):
@@ -344,12 +346,14 @@ class RecorderNode(LoopNode):
         for snap in list(self._pending):
             if self._advance(snap):
                 self._finish(snap)
-            elif now - snap.started > timeout:
+            elif now - snap.started > timeout and not snap.warned:
+                # keep asking: a loaded node answers late, and a client dropped under a pending
+                # request makes the node's own executor fail to send its response
+                snap.warned = True
                 self.get_logger().warning(
-                    f"no parameters from {snap.node} within {timeout:g} s; "
-                    "the bag will not know them until they change"
+                    f"no parameters from {snap.node} within {timeout:g} s yet; still asking "
+                    "(until then the bag does not know them)"
                 )
-                self._finish(snap)
 
     def _advance(self, snap: _Snapshot) -> bool:
         """One step of fetching a node's parameters; True when done (written or failed)."""

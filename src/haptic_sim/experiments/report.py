@@ -312,10 +312,11 @@ linear model leaves out:
   {_f(slow, "g", "none")} N/m, as in the thesis (3200 N/m).
 - **Without friction it does not.** The same observer without Coulomb friction vibrates from
   {_f(slow_nf, "g", "none")} N/m: the relay chatter has nothing to catch it.
-- **A fast observer re-excites it.** With c = 41.6 N s/m (the gain that gives the chapter-7 DOB
-  bandwidth) the first vibrating wall is {_f(fast, "g", "none")} N/m even with friction: the
-  estimate follows the stick-slip transitions within {1000 * 0.416 / 41.6:.0f} ms and feeds them
-  back a hundredfold.
+- **A fast observer does not let it rest.** With c = 41.6 N s/m (the gain that gives the
+  chapter-7 DOB bandwidth; time constant {1000 * 0.416 / 41.6:.0f} ms) the first vibrating wall
+  is {_f(fast, "g", "none")} N/m even with friction, with a slower oscillation (the grid's
+  frequencies): the estimate is fast enough to see the stick-slip transitions, and Kf = 100
+  feeds them back (a reading of the grid, not a separate experiment).
 
 So the mechanism the thesis guessed at (dissipation over a longer period) is, in the simulator,
 friction stopping a saturated relay oscillation that a slow observer does not re-excite. The

@@ -96,7 +96,7 @@ def device_node_specs() -> list[ParamSpec]:
         *simulation_specs(),
         ParamSpec(
             "lockstep_timeout_s",
-            0.5,
+            2.0,
             "lockstep: warn and re-send a sample after this long without its command (a "
             "best-effort input can drop a sample on a loaded machine)",
             "s",
