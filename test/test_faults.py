@@ -8,16 +8,20 @@ after the last command the applied effort (``joint_states.effort``) reaches zero
 
 from __future__ import annotations
 
+import json
 import os
 import signal
+import subprocess
 import time
 
 import numpy as np
 import pytest
 
+from conftest import tool
 from haptic_msgs_py.stamps import command_stamp, stamp_ns
 from haptic_msgs_py.topics import DIAGNOSTICS, EFFORT_COMMAND, JOINT_STATES, SESSION_TOPICS
-from rosgraph import Collector, isolated_env, restart, start_nodes
+from recorded import assert_received_written_in_bag, bag_stamps
+from rosgraph import Collector, Process, isolated_env, restart, start_nodes
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -169,3 +173,60 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         for p in procs.values():
             p.stop()
         col.close()
+
+
+def wait_for_effort(col: Collector, since: float, n: int, timeout: float) -> bool:
+    """``n`` samples with a pushing effort (> 0.1 N) arrived after ``since`` (monotonic s)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        t, _, e = efforts(col)
+        if np.sum(np.abs(e[t > since]) > 0.1) >= n:
+            return True
+        time.sleep(0.2)
+    return False
+
+
+def test_a_bag_recorded_across_a_node_kill_is_readable_and_analysable(root, tmp_path) -> None:
+    """haptic-record runs through kill -9 and restart of the environment node in real time: it
+    stops cleanly, wrote what it received, the gap is in the bag, and haptic-analyze reads it."""
+    env = isolated_env()
+    config = root / "config" / "slide_sim.yaml"
+    sets = ["device_node:clock_mode=realtime", "device_node:duration_s=0.0"]
+    bag = tmp_path / "across_kill"
+    col = Collector(env, {JOINT_STATES: SESSION_TOPICS[JOINT_STATES]})
+    rec = Process([tool("haptic-record"), str(bag)], env, tmp_path / "record.log")
+    procs = start_nodes(config, env, sets, tmp_path)
+    try:
+        assert wait_for_effort(col, 0.0, 4000, 60), procs["device_node"].output()[-2000:]
+        os.kill(procs["environment_node"].proc.pid, signal.SIGKILL)
+        procs["environment_node"].proc.wait(5)
+        time.sleep(1.0)
+        t_restart = time.monotonic()
+        restart(procs, "environment_node", env, tmp_path, config, sets)
+        assert wait_for_effort(col, t_restart, 4000, 60), "the loop did not resume"
+        os.killpg(rec.proc.pid, signal.SIGINT)
+        assert rec.wait(30) == 0, rec.output()
+    finally:
+        rec.stop()
+        for p in procs.values():
+            p.stop()
+        col.close()
+    assert_received_written_in_bag(bag)
+    stamps = bag_stamps(bag)
+    wall = stamps["/wrench_desired"]
+    gaps = np.diff(wall)
+    i = int(np.argmax(gaps))
+    assert gaps[i] > 0.5e9, "no gap of the wall force in the bag across the kill"
+    assert wall[i + 1 :].size > 3000, "the restarted environment node is not in the bag"
+    # the device went on through the kill: its samples span the gap
+    pose = stamps["/ee_pose"]
+    assert pose[0] < wall[i] and pose[-1] > wall[i + 1]
+    out = subprocess.run(
+        [tool("haptic-analyze"), "--json", str(bag)], capture_output=True, text=True, timeout=120
+    )
+    assert out.returncode == 0, out.stderr
+    segments = json.loads(out.stdout)
+    assert segments and all(s["controller"] == "OL" for s in segments)
+    assert any(
+        s["stiffness_n_per_m"] == 800.0 and s["bandwidth_hz"] is not None for s in segments
+    ), segments

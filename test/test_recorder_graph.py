@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import signal
@@ -11,16 +10,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
 from conftest import tool
 from haptic_dob.bag import analyze_bag, read_bag
-from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
+from haptic_dob.bag.cdr import command_label_stamp_ns
 from haptic_dob.bag.reader import open_bag
 from haptic_dob.control import ControlMode, ImpedanceLaw
 from haptic_msgs_py.stamps import NS_PER_S
 from haptic_msgs_py.topics import RECORDER_PROGRESS
 from haptic_sim.session import SessionConfig, run_session
+from recorded import assert_received_written_in_bag, bag_stamps
 from rosgraph import Collector, Process, isolated_env, launch, set_parameter
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
@@ -52,44 +51,6 @@ def assert_device_topics(
         assert np.array_equal(unique, np.arange(n) * MS), topic
         twice = sorted(unique[counts > 1].tolist())
         assert counts.max() <= 2 and twice == sorted(r for r in resends if r <= unique[-1]), topic
-
-
-def bag_stamps(path: Path) -> dict[str, np.ndarray]:
-    """Per topic, the stamps of its messages in bag order (header or effort@ label)."""
-    out: dict[str, list[int]] = {}
-    with open_bag(path) as reader:
-        for conn, _, data in reader.messages():
-            if conn.topic == "/parameter_events":
-                continue
-            read = (
-                command_label_stamp_ns
-                if conn.topic.endswith("effort_command")
-                else (header_stamp_ns)
-            )
-            out.setdefault(conn.topic, []).append(read(data))
-    return {t: np.array(s, dtype=np.int64) for t, s in out.items()}
-
-
-def recorder_report(path: Path) -> dict:
-    """The counts the recorder wrote into the bag's metadata."""
-    meta = yaml.safe_load((path / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
-    return json.loads(meta["custom_data"]["haptic_dob.recorder"])
-
-
-def message_counts(path: Path) -> dict[str, int]:
-    with open_bag(path) as reader:
-        return {c.topic: c.msgcount for c in reader.connections}
-
-
-def assert_received_written_in_bag(path: Path) -> dict:
-    """received = written for every topic, written = what the bag holds (+ snapshots)."""
-    report = recorder_report(path)
-    counts = message_counts(path)
-    for topic, c in report["topics"].items():
-        extra = report["parameter_snapshots"] if topic == "/parameter_events" else 0
-        assert c["written"] == c["received"] + extra, (path, topic, c)
-        assert counts[topic] == c["written"], (path, topic)
-    return report
 
 
 def test_recorded_lockstep_session_loses_nothing_and_equals_the_batch_run(root, tmp_path) -> None:

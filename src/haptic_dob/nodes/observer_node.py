@@ -101,7 +101,11 @@ class ObserverNode(LoopNode):
             self, SESSION_TOPICS[EFFORT_ESTIMATE], EFFORT_ESTIMATE, qos.LOOP
         )
         raw_subscription(
-            self, SESSION_TOPICS[JOINT_STATES], JOINT_STATES, self._on_joint_states, qos.LOOP_IN
+            self,
+            SESSION_TOPICS[JOINT_STATES],
+            JOINT_STATES,
+            self._on_joint_states,
+            qos.ESTIMATOR_IN,
         )
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.diagnostics = Diagnostics(self, self._report)
@@ -120,6 +124,10 @@ class ObserverNode(LoopNode):
         if self.diagnostics.rate_hz == 0.0:
             return WARN, "no joint_states in the last second", values
         return OK, "estimating", values
+
+    def drain_marker(self) -> int:
+        """The newest sample handled: at a stop, the samples still queued are answered first."""
+        return self._last_ns
 
     @staticmethod
     def _settings(values: Mapping[str, Any]) -> ObserverSettings:

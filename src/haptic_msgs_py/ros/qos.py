@@ -10,7 +10,10 @@ queue: on one host nothing is lost in practice, and skipping the acknowledgement
 lockstep cycle about 25 % faster on a 2-core machine (BENCHMARKS.md). A lost sample on the
 critical path of a lockstep run stalls it until the device re-sends the sample after
 ``lockstep_timeout_s``; every node answers a repeated sample idempotently, so the run stays
-exact. The observer counts gaps in the samples it receives.
+exact. The observer's input is reliable (``ESTIMATOR_IN``): off the critical path in OL and CL
+it may lag on a loaded machine, and a sample lost there would be a permanent gap in the recorded
+estimate; reliable delivery repairs it from the publisher's history. The observer counts gaps in
+the samples it receives.
 """
 
 from __future__ import annotations
@@ -31,6 +34,13 @@ LOOP_IN = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=LOOP_IN_DEPTH,
     reliability=ReliabilityPolicy.BEST_EFFORT,
+    durability=DurabilityPolicy.VOLATILE,
+)
+
+ESTIMATOR_IN = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=LOOP_IN_DEPTH,
+    reliability=ReliabilityPolicy.RELIABLE,
     durability=DurabilityPolicy.VOLATILE,
 )
 

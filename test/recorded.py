@@ -1,0 +1,50 @@
+"""Reading the bags the recorder wrote: stamps per topic, and its received/written counts."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
+from haptic_dob.bag.reader import open_bag
+
+
+def bag_stamps(path: Path) -> dict[str, np.ndarray]:
+    """Per topic, the stamps of its messages in bag order (header or effort@ label)."""
+    out: dict[str, list[int]] = {}
+    with open_bag(path) as reader:
+        for conn, _, data in reader.messages():
+            if conn.topic == "/parameter_events":
+                continue
+            read = (
+                command_label_stamp_ns
+                if conn.topic.endswith("effort_command")
+                else (header_stamp_ns)
+            )
+            out.setdefault(conn.topic, []).append(read(data))
+    return {t: np.array(s, dtype=np.int64) for t, s in out.items()}
+
+
+def recorder_report(path: Path) -> dict:
+    """The counts the recorder wrote into the bag's metadata."""
+    meta = yaml.safe_load((path / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    return json.loads(meta["custom_data"]["haptic_dob.recorder"])
+
+
+def message_counts(path: Path) -> dict[str, int]:
+    with open_bag(path) as reader:
+        return {c.topic: c.msgcount for c in reader.connections}
+
+
+def assert_received_written_in_bag(path: Path) -> dict:
+    """received = written for every topic, written = what the bag holds (+ snapshots)."""
+    report = recorder_report(path)
+    counts = message_counts(path)
+    for topic, c in report["topics"].items():
+        extra = report["parameter_snapshots"] if topic == "/parameter_events" else 0
+        assert c["written"] == c["received"] + extra, (path, topic, c)
+        assert counts[topic] == c["written"], (path, topic)
+    return report
