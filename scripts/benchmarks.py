@@ -83,12 +83,16 @@ def _launch(extra: list[str], sets: list[str], timeout: float) -> str:
     return out.stdout + out.stderr
 
 
+#: extra ``haptic-launch`` arguments of the graph benchmarks (``--set``, ``--rt-priority``)
+GRAPH_ARGS: list[str] = []
+
+
 def _lockstep(repeat: int, extra: list[str]) -> str:
     import re
 
     rtf = []
     for _ in range(repeat):
-        text = _launch(extra, ["device_node:duration_s=20.0"], 300)
+        text = _launch([*extra, *GRAPH_ARGS], ["device_node:duration_s=20.0"], 300)
         rtf.append(float(re.search(r"real-time factor ([0-9.]+)", text).group(1)))
     per_cycle_us = 1e3 / statistics.median(rtf)
     return (
@@ -116,7 +120,7 @@ def _realtime(repeat: int, extra: list[str]) -> str:
         with tempfile.TemporaryDirectory() as tmp:
             stats = os.path.join(tmp, "stats.json")
             _launch(
-                extra,
+                [*extra, *GRAPH_ARGS],
                 [
                     "device_node:clock_mode=realtime",
                     "device_node:duration_s=20.0",
@@ -164,7 +168,23 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__)
     p.add_argument("names", nargs="*", help=f"benchmarks to run: {', '.join(BENCHMARKS)}")
     p.add_argument("--repeat", type=int, default=5, help="repetitions (median reported)")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NODE:PARAM=VALUE",
+        help="a parameter of the graph benchmarks, as haptic-launch --set takes it (repeatable)",
+    )
+    p.add_argument(
+        "--rt-priority",
+        type=int,
+        metavar="P",
+        help="run the graph benchmarks' nodes under SCHED_FIFO priority P (haptic-launch option)",
+    )
     a = p.parse_args(argv)
+    GRAPH_ARGS[:] = [x for item in a.set for x in ("--set", item)]
+    if a.rt_priority is not None:
+        GRAPH_ARGS.extend(["--rt-priority", str(a.rt_priority)])
     unknown = [n for n in a.names if n not in BENCHMARKS]
     if unknown:
         p.error(f"unknown benchmark(s) {', '.join(unknown)}; choose from {', '.join(BENCHMARKS)}")

@@ -127,6 +127,7 @@ def launch_cli(*args: str, env=None) -> subprocess.CompletedProcess:
         (["slide_sim", "--set", "controller_node"], "ERROR: --set needs NODE:PARAM=VALUE"),
         (["slide_sim", "--set", "pilot_node:kf=1"], "ERROR: --set names unknown node 'pilot_node'"),
         (["slide_sim", "--set", "controller_node:kf=[1"], "the value is not valid YAML"),
+        (["slide_sim", "--rt-priority", "0"], "ERROR: --rt-priority 0: must be 1 to 99"),
     ],
 )
 def test_bad_input_gets_one_error_line(args, message) -> None:
@@ -198,3 +199,22 @@ def test_invalid_namespace_is_refused(bad: str) -> None:
 
     with pytest.raises(CliError, match="not a valid ROS namespace"):
         normalize_namespace(bad)
+
+
+def test_rt_priority_without_permission_is_one_line(monkeypatch) -> None:
+    from haptic_dob.cli import CliError
+    from haptic_dob.launcher import set_rt_priority
+
+    def refuse(*_args: object) -> None:
+        raise PermissionError(1, "Operation not permitted")
+
+    monkeypatch.setattr(os, "sched_setscheduler", refuse)
+    with pytest.raises(CliError, match=r"not permitted .* needs root, CAP_SYS_NICE"):
+        set_rt_priority(10)
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="SCHED_FIFO needs root here")
+def test_rt_priority_runs_the_nodes_under_sched_fifo(root, tmp_path) -> None:
+    out = launch_cli("slide_sim", "--rt-priority", "10", "--set", "device_node:duration_s=0.5")
+    assert out.returncode == 0, out.stderr
+    assert "scheduling SCHED_FIFO priority 10" in out.stderr

@@ -290,6 +290,27 @@ def normalize_namespace(namespace: str) -> str:
     return ns
 
 
+RT_PRIORITIES = range(1, 100)  # SCHED_FIFO priorities Linux accepts
+
+
+def set_rt_priority(priority: int) -> None:
+    """Run this process (and the processes and threads it starts) with ``SCHED_FIFO``.
+
+    Raises ``CliError`` with the reason when the system does not allow it.
+    """
+    if priority not in RT_PRIORITIES:
+        raise CliError(f"--rt-priority {priority}: must be 1 to 99 (SCHED_FIFO priorities)")
+    if not hasattr(os, "sched_setscheduler"):
+        raise CliError("--rt-priority: this system has no SCHED_FIFO scheduling (Linux only)")
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except PermissionError as exc:
+        raise CliError(
+            f"--rt-priority {priority}: not permitted ({exc.strerror}); it needs root, "
+            "CAP_SYS_NICE, or an rtprio limit (limits.conf) of at least that priority"
+        ) from None
+
+
 def command(
     config: str,
     namespace: str,
@@ -303,6 +324,7 @@ def command(
     peers: Sequence[str] = (),
     record: str | None = None,
     record_storage: str = "mcap",
+    rt_priority: int | None = None,
 ) -> int:
     """Resolve, plan and run; raises ``CliError`` on bad input."""
     import tempfile
@@ -313,6 +335,8 @@ def command(
     if record:
         add_recorder(params, record, record_storage)
     net = network_env(network, peers)
+    if rt_priority is not None:  # the nodes started below inherit the policy
+        set_rt_priority(rt_priority)
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
         specs = select(plan(params, write_params_file(params, Path(tmp)), namespace), only)
         if composed:
@@ -382,6 +406,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--record-storage", choices=["mcap", "sqlite3"], default="mcap", help="default mcap"
     )
+    p.add_argument(
+        "--rt-priority",
+        type=int,
+        metavar="P",
+        help="run the nodes with real-time scheduling, SCHED_FIFO priority P (1-99; Linux, needs "
+        "root or CAP_SYS_NICE): fewer late commands in real time (BENCHMARKS.md)",
+    )
     a = p.parse_args(argv)
     only = [n for n in a.only.split(",") if n]
     peers = [h for h in a.peers.split(",") if h]
@@ -399,6 +430,7 @@ def main(argv: list[str] | None = None) -> int:
             peers,
             a.record,
             a.record_storage,
+            a.rt_priority,
         )
     )
 

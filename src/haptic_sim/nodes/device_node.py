@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 import time
 from collections.abc import Mapping
@@ -209,7 +210,8 @@ class DeviceNode(LoopNode):
         self.diagnostics = Diagnostics(self, self._report)
         mode = "lockstep" if self.lockstep else f"realtime at {v['rate_hz']:g} Hz"
         self.get_logger().info(
-            f"simulated {v['model']} device, {mode}, effort limits {list(self.limits)}"
+            f"simulated {v['model']} device, {mode}, effort limits {list(self.limits)}, "
+            f"scheduling {scheduling()}"
         )
 
     # --- parameters -------------------------------------------------------------------------
@@ -512,6 +514,13 @@ class DeviceNode(LoopNode):
         if not self.lockstep and self._started:
             self._step(self._zero)
         self.get_logger().info("shutdown: effort zeroed")
+
+
+def scheduling() -> str:
+    """This process's CPU scheduling: ``SCHED_FIFO priority 50`` or ``normal``."""
+    if hasattr(os, "sched_getscheduler") and os.sched_getscheduler(0) == os.SCHED_FIFO:
+        return f"SCHED_FIFO priority {os.sched_getparam(0).sched_priority}"
+    return "normal"
 
 
 def main(args: list[str] | None = None) -> int:
