@@ -152,6 +152,44 @@ def test_records_counts_snapshots_and_reports_progress(context, tmp_path, storag
     assert json.loads(json.dumps(report)) == report
 
 
+def test_progress_is_held_while_a_node_has_not_given_its_parameters(context, tmp_path) -> None:
+    """A lockstep run must not end before the bag knows a node's parameters: the reported
+    progress stays where the node appeared until it answers or ``snapshot_timeout_s`` passed."""
+    rec = RecorderNode(
+        context=context,
+        parameter_overrides=[
+            Parameter("output", value=str(tmp_path / "bag")),
+            Parameter("topics", value=["ee_pose", "/parameter_events"]),
+            Parameter("snapshot_timeout_s", value=1.0),
+        ],
+    )
+    src = rclpy.create_node("silent_node", context=context, start_parameter_services=False)
+    pose_pub = RawPublisher(src, SESSION_TOPICS[EE_POSE], EE_POSE, qos.LOOP)
+    ex = SingleThreadedExecutor(context=context)
+    ex.add_node(rec)
+    ex.add_node(src)
+    try:
+        assert spin_until(ex, lambda: any(p.node == "/silent_node" for p in rec._pending), 10.0)
+        t_seen = time.monotonic()
+        pose = wire.pose_stamped("base_link")
+        for k in range(100):
+            pose.header.stamp.sec, pose.header.stamp.nanosec = divmod(k * 1_000_000, 10**9)
+            pose_pub.publish(pose)
+        assert spin_until(ex, lambda: rec.counts[0].received == 100, 10.0)
+        assert rec.progress_ns() == 99_000_000
+        if time.monotonic() - t_seen < 0.9:  # still within snapshot_timeout_s
+            assert rec.reported_progress_ns() == 0
+        # the node never answers: after the timeout it is warned about and the hold ends
+        assert spin_until(ex, lambda: rec.reported_progress_ns() == 99_000_000, 10.0)
+        assert time.monotonic() - t_seen >= 0.9
+        assert rec.snapshots == 0
+    finally:
+        ex.shutdown()
+        rec.close()
+        src.destroy_node()
+        rec.destroy_node()
+
+
 def test_refuses_to_overwrite_and_names_bad_topics(tmp_path: Path) -> None:
     existing = tmp_path / "bag"
     existing.mkdir()

@@ -14,7 +14,9 @@
   ``frame_id`` so a device can follow the slowest of several; reliable, transient local) at
   ``progress_rate_hz``: the newest stamp written, minimum over the stamped topics that are
   flowing (header stamps; the effort command's ``effort@<stamp>`` label). A lockstep device
-  holds the loop while that lags, so a recorded lockstep run loses nothing.
+  holds the loop while that lags, so a recorded lockstep run loses nothing. The report is held
+  where a node appeared until its parameters came (at most ``snapshot_timeout_s``), so a short
+  lockstep run cannot end before the bag knows the session's parameters.
 - On SIGINT/SIGTERM (or after ``duration_s``) it takes what is still queued (at most
   ``drain_timeout_s``, until nothing arrives for 0.1 s), then closes the bag so it is readable,
   and reports per topic what it received, wrote and which stamps are missing (gaps).
@@ -193,6 +195,7 @@ class _Snapshot:
     started: float
     list_client: Any
     get_client: Any
+    progress_ns: int = 0  # the recorder's progress when the node appeared
     future: Any = None
     names: list[str] | None = None
     warned: bool = False
@@ -314,10 +317,16 @@ class RecorderNode(LoopNode):
         top = max(newest)
         return min(n for n in newest if n >= top - FLOWING_NS)
 
+    def reported_progress_ns(self) -> int:
+        """``progress_ns``, held where a node appeared while its parameters are still asked for
+        (at most ``snapshot_timeout_s``): a lockstep run waits for what the bag must know."""
+        held = [s.progress_ns for s in self._pending if not s.warned]
+        return min([self.progress_ns(), *held])
+
     def _publish_progress(self) -> None:
         if self._closed:
             return
-        sec, nsec = divmod(self.progress_ns(), NS_PER_S)
+        sec, nsec = divmod(self.reported_progress_ns(), NS_PER_S)
         self._progress_msg.stamp.sec, self._progress_msg.stamp.nanosec = sec, nsec
         self._progress.publish(self._progress_msg)
 
@@ -340,6 +349,7 @@ class RecorderNode(LoopNode):
                         now,
                         self.create_client(ListParameters, f"{full}/list_parameters"),
                         self.create_client(GetParameters, f"{full}/get_parameters"),
+                        self.progress_ns(),
                     )
                 )
         timeout = self.params.values["snapshot_timeout_s"]
@@ -427,14 +437,34 @@ class RecorderNode(LoopNode):
             else:
                 time.sleep(0.005)
 
+    def _finish_snapshots(self) -> None:
+        """Wait (within ``drain_timeout_s``) for the snapshots still asked for: in a short run a
+        loaded node may answer after the session ended; a snapshot declares values from the
+        start, so a late one still labels the whole bag. Only when this node spins alone (in a
+        composition the other nodes have shut down already)."""
+        ex = self.executor
+        if ex is None or len(ex.get_nodes()) != 1:
+            return
+        deadline = time.monotonic() + self.params.values["drain_timeout_s"]
+        while self._pending and time.monotonic() < deadline:
+            ex.spin_once(timeout_sec=0.02)
+            for snap in list(self._pending):
+                if self._advance(snap):
+                    self._finish(snap)
+
     def close(self) -> None:
         """Drain, write the counts into the bag's metadata and close it (idempotent)."""
         if self._closed:
             return
         try:
+            self._finish_snapshots()
             self._drain()
         except Exception as exc:  # the context may already be gone
             self.get_logger().warning(f"could not drain the queues: {exc}")
+        for snap in self._pending:
+            self.get_logger().warning(
+                f"closing without the parameters of {snap.node}: it never answered"
+            )
         self._closed = True
         self._writer.set_custom_data("haptic_dob.recorder", json.dumps(self.report()))
         self._writer.close()
