@@ -173,3 +173,44 @@ def test_device_holds_the_loop_while_a_recorder_lags(context) -> None:
         assert not res.successful
     finally:
         dev.destroy_node()
+
+
+def test_after_a_switch_the_controller_waits_for_a_lagging_input(context) -> None:
+    """In OL the observer is off the lockstep critical path and may lag; after the switch to DOB
+    the controller waits for estimate k (no fallback, no zero command); once caught up, a silent
+    input still trips the fallback after ``input_timeout_s``."""
+    from haptic_msgs_py import wire
+    from haptic_msgs_py.convert import write_force
+    from haptic_msgs_py.stamps import command_stamp
+
+    ctl = ControllerNode(context=context)
+    assert ctl.set_parameters([Parameter("kf", value=1.0)])[0].successful
+    sent: dict[int, float] = {}
+    ctl._pub.publish = lambda m: sent.__setitem__(
+        command_stamp(m.layout.dim[0].label), float(m.data[0])
+    )
+    period = ctl.period_ns
+
+    def wrench(k: int, fx: float):
+        msg = wire.wrench_stamped("base_link")
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(k * period, 10**9)
+        write_force(msg, (fx, 0.0, 0.0))
+        return msg
+
+    try:
+        for k in range(100):  # OL; the observer 50 cycles behind
+            ctl._on_desired(wrench(k, -1.0))
+            if k >= 50:
+                ctl._on_estimated(wrench(k - 50, 0.5))
+        assert ctl.set_parameters([Parameter("mode", value="DOB")])[0].successful
+        ctl._on_desired(wrench(100, -1.0))
+        assert 100 * period not in sent and ctl.fallback_reason is None  # waiting
+        for k in range(50, 101):
+            ctl._on_estimated(wrench(k, 0.5))
+        assert sent[100 * period] == -1.0 + 1.0 * (-1.0 + 0.5)  # the DOB law, stamp-100 inputs
+        assert ctl.fallbacks == 0
+        for k in range(101, 130):  # caught up; now the estimate stops
+            ctl._on_desired(wrench(k, -1.0))
+        assert ctl.fallback_reason and "wrench_estimate" in ctl.fallback_reason
+    finally:
+        ctl.destroy_node()

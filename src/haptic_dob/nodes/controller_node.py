@@ -11,10 +11,12 @@ observer must be warm before DOB takes over).
 Fallback: when the force input the mode needs stops (the observer died in DOB, the sensor stream in
 CL) -- its newest sample is more than ``input_timeout_s`` of sample time older than the cycle --
 the controller renders with ``fallback`` (``zero``: no force; ``OL``: the wall force alone), says
-so, and returns to its mode once the input flows again (warm, as for a switch). Only sample
-stamps decide, never the wall clock, so a lockstep run stays deterministic under any load (a dead
-input stalls it instead, and the device and controller say which input is missing); in real time
-the device's watchdog zeroes the force while the controller waits.
+so, and returns to its mode once the input flows again (warm, as for a switch). Right after a
+switch the new input may lag behind the cycle (off the lockstep critical path until then): while
+it still flows the controller waits for it instead of falling back, so the switch stays bumpless.
+Only sample stamps decide, never the wall clock, so a lockstep run stays deterministic under any
+load (a dead input stalls it instead, and the device and controller say which input is missing);
+in real time the device's watchdog zeroes the force while the controller waits.
 Without the wall force (``wrench_desired``) it sends nothing and the device's watchdog zeroes the
 effort. ``/diagnostics`` reports the mode, the fallback state and the inputs still awaited.
 """
@@ -142,6 +144,9 @@ class ControllerNode(LoopNode):
         self._warned_ns = -1
         self.fallback_reason: str | None = None
         self.fallbacks = 0
+        # after a switch to a mode with a force input: wait while that input, still flowing,
+        # catches up with the cycle (off the lockstep critical path until now, it may lag)
+        self._catching_up = False
         self._cmd = wire.float64_multi_array("", [0.0] * self.model.dof)
         self._dim = self._cmd.layout.dim[0]
         self._pub = RawPublisher(self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, qos.LOOP)
@@ -174,6 +179,8 @@ class ControllerNode(LoopNode):
         return law
 
     def _apply(self, law: ImpedanceLaw) -> None:
+        if law.needs is not None and law.needs != self.controller.law.needs:
+            self._catching_up = True  # the new input may lag (it was off the critical path)
         self.controller.law = law
         self.get_logger().info(
             f"law now {law.mode.value}, Kf {law.kf:g}, max {law.max_force_n:g} N, from the cycle "
@@ -241,6 +248,7 @@ class ControllerNode(LoopNode):
         if force is not None:
             src, topic = force
             if src.stamp == k:
+                self._catching_up = False
                 if self.fallback_reason and src.flowing(k, self.period_ns):
                     self.fallback_reason = None
                     self.get_logger().info(f"{topic} flows again: back to {self._mode()}")
@@ -248,6 +256,8 @@ class ControllerNode(LoopNode):
                 timeout_ns = self.params.values["input_timeout_s"] * 1e9
                 if k - src.stamp <= timeout_ns:
                     return  # on its way: wait for it
+                if self._catching_up and src.flowing(k, self.period_ns):
+                    return  # lagging behind after a switch, but coming: wait for it
                 self._fall_back(f"{topic} silent for {(k - src.stamp) * 1e-6:.0f} ms of samples")
         if k != self._sent_ns:
             if self.fallback_reason is None:
