@@ -17,8 +17,10 @@ demo: $(STAMP)
 reproduce: $(STAMP)
 	@$(BIN)/haptic-experiment --out report
 
+# CI= : pytest prints whole assertion diffs when CI is set; one failure's diff of a 5000-sample
+# list could then hide every other failure in a truncated log
 test: $(STAMP)
-	@$(BIN)/python -m pytest -q -p no:cacheprovider
+	@CI= BUILD_NUMBER= $(BIN)/python -m pytest -q -p no:cacheprovider
 
 install: $(STAMP)
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import os
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -63,6 +64,16 @@ class Process:
     def output(self) -> str:
         """What the process wrote so far (when logging to a file)."""
         return self.log_path.read_text() if self.log_path else ""
+
+
+def resent(log: str) -> list[int]:
+    """Stamps (ns) of the samples the device sent twice (its lockstep re-send after a timeout).
+
+    A sample lost on a best-effort loop input stalls a lockstep run until the device sends it
+    again (``lockstep_timeout_s``); it logs each re-send, so a test can tell them from duplicates.
+    """
+    found = re.findall(r"no effort_command for cycle (\d+) .*Sending the sample again", log)
+    return [int(k) * 1_000_000 for k in found]
 
 
 def launch(

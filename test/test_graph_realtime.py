@@ -13,10 +13,13 @@ pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
 @pytest.mark.parametrize("composed", [False, True], ids=["processes", "composed"])
 def test_realtime_loop_closes_at_rate(root, tmp_path, composed: bool) -> None:
-    """3 s at 1 kHz: about 3000 ticks, commands labelled with their sample come back.
+    """3 s at 1 kHz: 3000 ticks, commands labelled with their sample come back.
 
-    The share of commands arriving before the next tick is a benchmark (BENCHMARKS.md); the test
-    only asserts that the loop closes (most commands are on time) and that nothing is refused.
+    The device starts ticking once the graph is up (``wait_for``), so the loop closes within its
+    first cycles rather than whenever the other processes happen to finish starting. The share of
+    commands arriving before the next tick is a benchmark (BENCHMARKS.md); the test only asserts
+    that the loop closes early (commands for at least 2700 of 3000 ticks, most of them on time)
+    and that nothing is refused.
     """
     env = isolated_env()
     stats = tmp_path / "stats.json"
@@ -38,5 +41,6 @@ def test_realtime_loop_closes_at_rate(root, tmp_path, composed: bool) -> None:
     s = json.loads(stats.read_text())
     assert s["cycles"] == 3000
     assert s["refused_commands"] == 0
+    assert s["commands_on_time"] + s["commands_late"] >= 2700, s
     assert s["on_time_pct"] > 50.0, s
     assert 0.0 < s["latency_p50_ms"] < 1.0, s

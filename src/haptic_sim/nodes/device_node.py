@@ -12,8 +12,9 @@ force sensor), ``sim/hand_wrench`` (the true hand force, for evaluation) and, in
   also holds the next sample when the recorder lags more than ``max_recorder_lag_s`` of simulated
   time, so a recording of a lockstep run never loses a sample. Stops after ``duration_s``
   (0: never), once a recorder (if any) has written the last sample.
-- realtime: ticks at ``rate_hz`` and applies the newest valid command; records whether command k
-  arrived before the next tick and its latency (``stats_file``).
+- realtime: once the ``wait_for`` nodes are up (as in lockstep; ``[]`` starts at once), ticks at
+  ``rate_hz`` and applies the newest valid command; records whether command k arrived before the
+  next tick and its latency (``stats_file``).
 
 Safety (every path, both modes): each joint's effort is clamped to ``effort_limits`` (at most the
 actuator's own saturation; changeable at run time); a command of the wrong length or with NaN/inf
@@ -107,13 +108,14 @@ def device_node_specs() -> list[ParamSpec]:
         ParamSpec(
             "wait_for",
             list(DEFAULT_WAIT_FOR),
-            "lockstep: nodes (in this namespace) that must be up before sample 0",
+            "nodes (in this namespace) that must be up before sample 0, in both clock modes "
+            "(realtime with []: tick at once, the watchdog holds zero effort until commands come)",
             read_only=True,
         ),
         ParamSpec(
             "start_delay_s",
             0.5,
-            "lockstep: settle time between the graph being up and "
+            "settle time between the wait_for graph being up and "
             "sample 0 (endpoint matching between the other nodes)",
             "s",
             0.0,
@@ -374,17 +376,19 @@ class DeviceNode(LoopNode):
             self._check_drained()
             self._deadline = now + 0.05
             return
+        if not self._started and self._ready_since is None:
+            if self._graph_ready():
+                self._ready_since = now
+                if self.lockstep or self.params.values["wait_for"]:
+                    self._deadline = now + self.params.values["start_delay_s"]
+                    return
+            else:
+                self._deadline = now + 0.05
+                return
         if not self.lockstep:
             self._tick(now)
             return
         if not self._started:
-            if self._ready_since is None:
-                if self._graph_ready():
-                    self._ready_since = now
-                    self._deadline = now + self.params.values["start_delay_s"]
-                else:
-                    self._deadline = now + 0.05
-                return
             self._started = True
             self._t_first = now
             self._publish(self.device.sample())
