@@ -107,7 +107,7 @@ class Collector:
     ) -> None:
         import rclpy
         from rclpy.context import Context
-        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.experimental import EventsExecutor
 
         from haptic_msgs_py.ros.qos import RECORD
         from haptic_msgs_py.ros.raw import rclpy_type
@@ -144,7 +144,9 @@ class Collector:
 
             qos = RECORD if topic in SESSION_TOPICS else volatile
             self.node.create_subscription(rclpy_type(typename), topic, cb, qos, raw=True)
-        self.executor = SingleThreadedExecutor(context=self.context)
+        # the events executor (as the nodes use): a loaded machine must not leave this test's
+        # own subscriber more than the publishers' 2000-sample history behind
+        self.executor = EventsExecutor(context=self.context)
         self.executor.add_node(self.node)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._spin, daemon=True)

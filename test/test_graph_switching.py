@@ -29,8 +29,11 @@ TOPICS = {
 }
 
 
-def laws(col: Collector, kf: float) -> tuple[list[int], list[set[str]]]:
-    """For each command: its stamp and the laws (OL, CL, DOB) that give exactly that command.
+def laws(
+    col: Collector, kf: float
+) -> tuple[list[int], list[set[str]], list[tuple[float, dict[str, float]]]]:
+    """For each command: its stamp, the laws (OL, CL, DOB) that give exactly that command, and
+    (for messages) the command with each law's value.
 
     Several laws can match one command (out of contact all are zero; at the force limit they
     saturate alike), so a command is checked against the law in force, never guessed.
@@ -39,7 +42,7 @@ def laws(col: Collector, kf: float) -> tuple[list[int], list[set[str]]]:
         t: {stamp_ns(m): read_force(m)[0] for m in col.messages(t)}
         for t in (WRENCH_DESIRED, WRENCH_MEASURED, WRENCH_ESTIMATE)
     }
-    stamps, matches = [], []
+    stamps, matches, values = [], [], []
     for c in col.messages(EFFORT_COMMAND):
         k = command_stamp(c.layout.dim[0].label)
         if k not in by_stamp[WRENCH_DESIRED]:
@@ -53,7 +56,8 @@ def laws(col: Collector, kf: float) -> tuple[list[int], list[set[str]]]:
             candidates["DOB"] = fw + kf * (fw + by_stamp[WRENCH_ESTIMATE][k])
         stamps.append(k)
         matches.append({n for n, v in candidates.items() if abs(np.clip(v, -4, 4) - u) < 1e-12})
-    return stamps, matches
+        values.append((u, candidates))
+    return stamps, matches, values
 
 
 def test_switch_ol_dob_cl_takes_effect_on_the_next_cycle(root, tmp_path) -> None:
@@ -83,7 +87,7 @@ def test_switch_ol_dob_cl_takes_effect_on_the_next_cycle(root, tmp_path) -> None
     finally:
         graph.stop()
         col.close()
-    stamps, matches = laws(col, kf=1.0)
+    stamps, matches, values = laws(col, kf=1.0)
     assert stamps == sorted(stamps)
     # the controller names the last cycle of the old law; from the next cycle on every command is
     # the new law's ("the next cycle")
@@ -98,10 +102,16 @@ def test_switch_ol_dob_cl_takes_effect_on_the_next_cycle(root, tmp_path) -> None
     def law_at(k: int) -> str:
         return "OL" if k <= last_old["DOB"] else "DOB" if k <= last_old["CL"] else "CL"
 
-    wrong = [(k, law_at(k), m) for k, m in zip(stamps, matches, strict=True) if law_at(k) not in m]
-    assert not wrong, f"commands not of the law in force: {wrong[:5]}"
+    # a command is judged when the collector holds the inputs of the law in force: on a loaded
+    # machine this test's own subscriber can fall more than its 2000-sample history behind and
+    # miss some (the controller had them: it waits for them)
+    rows = list(zip(stamps, matches, values, strict=True))
+    judged = [(k, m, v) for k, m, v in rows if law_at(k) in v[1]]
+    assert len(judged) >= len(rows) // 2, (len(judged), len(rows))
+    wrong = [(k, law_at(k), m, v) for k, m, v in judged if law_at(k) not in m]
+    assert not wrong, f"{len(wrong)} commands not of the law in force: {wrong[:5]}"
     # the laws are told apart in most cycles (in contact, below the force limit), so the check
     # above has teeth
-    only = [next(iter(m)) for m in matches if len(m) == 1]
+    only = [next(iter(m)) for _, m, v in rows if len(v[1]) == 3 and len(m) == 1]
     for law in ("OL", "DOB", "CL"):
         assert only.count(law) >= 100, (law, only.count(law))
