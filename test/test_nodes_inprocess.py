@@ -214,3 +214,28 @@ def test_after_a_switch_the_controller_waits_for_a_lagging_input(context) -> Non
         assert ctl.fallback_reason and "wrench_estimate" in ctl.fallback_reason
     finally:
         ctl.destroy_node()
+
+
+@pytest.mark.parametrize("wait_for", ["[absent_node]", "[]"])
+def test_a_realtime_device_ticks_only_once_its_graph_is_up(monkeypatch, wait_for: str) -> None:
+    """In real time as in lockstep the device waits for ``wait_for`` (and says for what);
+    ``[]`` ticks at once."""
+    import time
+
+    monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
+    ctx = Context()
+    args = ["--ros-args", "-p", "clock_mode:=realtime", "-p", f"wait_for:={wait_for}"]
+    rclpy.init(context=ctx, args=args)
+    dev = DeviceNode(context=ctx)
+    try:
+        for _ in range(5):
+            dev.on_wakeup(time.monotonic())
+        if wait_for == "[]":
+            assert dev._started and dev.device.k >= 1
+        else:
+            assert not dev._started and dev.device.k == 0
+            assert dev._waiting_for() == "node absent_node in /"
+            assert dev._report()[1] == "waiting for the graph"
+    finally:
+        dev.destroy_node()
+        rclpy.try_shutdown(context=ctx)

@@ -43,8 +43,15 @@ def descriptor(spec: ParamSpec) -> ParameterDescriptor:
     return d
 
 
+def unset_as_empty(spec: ParamSpec, value: Any) -> Any:
+    """An array given as ``[]`` (YAML or ``-p name:=[]``) reaches rclpy untyped, as "not set"
+    (None): for an array parameter that is the empty list."""
+    return [] if value is None and spec.kind is list else value
+
+
 def normalise(spec: ParamSpec, value: Any) -> Any:
     """Python value of the spec's kind (ints for float specs become floats, arrays lists)."""
+    value = unset_as_empty(spec, value)
     if spec.kind is float and isinstance(value, int) and not isinstance(value, bool):
         return float(value)
     if spec.kind is list:
@@ -106,7 +113,7 @@ class ParameterTable:
                 continue
             if spec.read_only and not self._declaring:
                 return SetParametersResult(successful=False, reason=f"{p.name} is read-only")
-            reason = spec.check(p.value)
+            reason = spec.check(unset_as_empty(spec, p.value))
             if reason:
                 return SetParametersResult(successful=False, reason=reason)
             proposed[p.name] = normalise(spec, p.value)

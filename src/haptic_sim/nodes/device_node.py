@@ -422,11 +422,27 @@ class DeviceNode(LoopNode):
         self._deadline = now + self.params.values["lockstep_timeout_s"]
 
     def _graph_ready(self) -> bool:
-        """Every ``wait_for`` node is up, known subscribers matched, a command publisher seen."""
+        """Every ``wait_for`` node is up, known subscribers matched, a command publisher seen.
+
+        While not, says what it waits for (every 5 s), so a device that does not start says why.
+        """
+        waiting = self._waiting_for()
+        if waiting:
+            self.get_logger().info(
+                f"waiting before sample 0 for {waiting} (wait_for: "
+                f"{list(self.params.values['wait_for'])})",
+                throttle_duration_sec=5.0,
+            )
+        return not waiting
+
+    def _waiting_for(self) -> str:
+        """What the start still waits for ('' when nothing)."""
+        wait_for = self.params.values["wait_for"]
         ns = self.get_namespace()
         names = {n for n, space in self.get_node_names_and_namespaces() if space == ns}
-        if any(w not in names for w in self.params.values["wait_for"]):
-            return False
+        missing = [w for w in wait_for if w not in names]
+        if missing:
+            return f"node{'s' if len(missing) > 1 else ''} {', '.join(missing)} in {ns}"
         for pub, topic in (
             (self._p_js, JOINT_STATES),
             (self._p_pose, EE_POSE),
@@ -434,8 +450,10 @@ class DeviceNode(LoopNode):
             (self._p_measured, WRENCH_MEASURED),
         ):
             if pub.get_subscription_count() < self.count_subscribers(topic):
-                return False
-        return self._sub.get_publisher_count() >= 1 or not self.params.values["wait_for"]
+                return f"the subscribers of {topic} to match"
+        if wait_for and self._sub.get_publisher_count() < 1:
+            return f"a publisher of {EFFORT_COMMAND}"
+        return ""
 
     def _tick(self, now: float) -> None:
         period = self.period_ns * 1e-9
