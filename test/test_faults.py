@@ -167,7 +167,9 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
             time.sleep(0.2)
         else:
             pytest.fail(f"the loop did not resume after restarting {victim}")
-        assert np.any(e[-100:] != 0.0)
+        # ... and keeps coming (a snapshot of the last samples could fall in a watchdog trip
+        # when this loaded machine stalls a process for more than the 5 ms command timeout)
+        assert wait_for_effort(col, t_restart, 400, 20), f"the loop did not stay closed: {victim}"
         assert after.any()
     finally:
         for p in procs.values():
