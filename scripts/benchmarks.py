@@ -181,10 +181,17 @@ def main(argv: list[str] | None = None) -> int:
         metavar="P",
         help="run the graph benchmarks' nodes under SCHED_FIFO priority P (haptic-launch option)",
     )
+    p.add_argument(
+        "--pin",
+        action="store_true",
+        help="pin the graph benchmarks' node processes to CPUs (haptic-launch option)",
+    )
     a = p.parse_args(argv)
     GRAPH_ARGS[:] = [x for item in a.set for x in ("--set", item)]
     if a.rt_priority is not None:
         GRAPH_ARGS.extend(["--rt-priority", str(a.rt_priority)])
+    if a.pin:
+        GRAPH_ARGS.append("--pin")
     unknown = [n for n in a.names if n not in BENCHMARKS]
     if unknown:
         p.error(f"unknown benchmark(s) {', '.join(unknown)}; choose from {', '.join(BENCHMARKS)}")

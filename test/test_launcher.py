@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,6 +16,13 @@ from haptic_msgs_py.topics import JOINT_STATES, SESSION_TOPICS
 from haptic_sim.session import SessionConfig, run_session
 from rosgraph import Collector, isolated_env, launch
 
+#: executable (as in a node's command line) -> node name
+NODE_NAMES = {
+    "haptic-device-node": "device_node",
+    "haptic-environment-node": "environment_node",
+    "haptic-observer-node": "observer_node",
+    "haptic-controller-node": "controller_node",
+}
 NODE_EXES = (
     "haptic-device-node",
     "haptic-environment-node",
@@ -128,6 +136,7 @@ def launch_cli(*args: str, env=None) -> subprocess.CompletedProcess:
         (["slide_sim", "--set", "pilot_node:kf=1"], "ERROR: --set names unknown node 'pilot_node'"),
         (["slide_sim", "--set", "controller_node:kf=[1"], "the value is not valid YAML"),
         (["slide_sim", "--rt-priority", "0"], "ERROR: --rt-priority 0: must be 1 to 99"),
+        (["slide_sim", "--pin", "--composed"], "ERROR: --pin places the nodes' processes"),
     ],
 )
 def test_bad_input_gets_one_error_line(args, message) -> None:
@@ -218,3 +227,77 @@ def test_rt_priority_runs_the_nodes_under_sched_fifo(root, tmp_path) -> None:
     out = launch_cli("slide_sim", "--rt-priority", "10", "--set", "device_node:duration_s=0.5")
     assert out.returncode == 0, out.stderr
     assert "scheduling SCHED_FIFO priority 10" in out.stderr
+
+
+def _affinity_of_every_thread(pid: int) -> set[int]:
+    """The CPUs any thread of process ``pid`` may run on."""
+    cpus: set[int] = set()
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            cpus |= os.sched_getaffinity(int(tid))
+        except ProcessLookupError:  # a thread that just ended
+            continue
+    return cpus
+
+
+@pytest.mark.multiprocess
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="--pin needs 2 CPUs")
+def test_pin_runs_each_node_process_on_its_planned_cpu(root, tmp_path) -> None:
+    """Every thread of each node process (the middleware's too) runs on the CPU of the plan."""
+    from haptic_msgs_py.cpus import available_cpus, placement
+
+    plan = placement(list(NODE_NAMES.values()), available_cpus())
+    log = tmp_path / "launch.log"
+    proc = launch(
+        "slide_sim",
+        isolated_env(),
+        ["device_node:clock_mode=realtime", "device_node:duration_s=0.0"],
+        log,
+        ["--pin"],
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and log.read_text().count("process pinned") < 4:
+            assert proc.proc.poll() is None, log.read_text()
+            time.sleep(0.2)
+        text = log.read_text()
+        assert text.count("process pinned") == 4, text
+        kids = children_of(proc.proc.pid)
+        seen = {}
+        for pid in kids:
+            cmdline = Path(f"/proc/{pid}/cmdline").read_text(encoding="utf-8")
+            name = next(n for exe, n in NODE_NAMES.items() if exe in cmdline)
+            seen[name] = sorted(_affinity_of_every_thread(pid))
+        assert seen == plan, text
+        for name, cpus in plan.items():
+            assert f"[{name}]: process pinned to CPU {cpus[0]}" in text
+    finally:
+        code = proc.stop()
+    assert code == 0, log.read_text()
+
+
+@pytest.mark.multiprocess
+def test_an_unusable_cpu_affinity_stops_the_graph_with_its_reason() -> None:
+    out = launch_cli("slide_sim", "--set", "device_node:cpu_affinity=[4096]")
+    assert out.returncode == 1
+    assert "ERROR: cpu_affinity: CPU 4096 not available to this process" in out.stderr
+    assert "device_node exited with code 2" in out.stderr and "Traceback" not in out.stderr
+
+
+def test_pin_on_one_cpu_is_one_line(monkeypatch) -> None:
+    from haptic_dob import launcher
+    from haptic_dob.cli import CliError
+    from haptic_msgs_py import cpus
+
+    monkeypatch.setattr(cpus, "available_cpus", lambda: [0])
+    with pytest.raises(CliError, match="--pin: pinning needs at least 2 CPUs"):
+        launcher.add_pinning({"device_node": {}, "controller_node": {}})
+
+
+def test_pin_keeps_an_affinity_the_config_gives() -> None:
+    from haptic_dob.launcher import add_pinning
+
+    params = {"/**": {}, "device_node": {"cpu_affinity": [1]}, "environment_node": {}}
+    add_pinning(params)
+    assert params["device_node"]["cpu_affinity"] == [1]
+    assert params["environment_node"]["cpu_affinity"] and "cpu_affinity" not in params["/**"]

@@ -127,6 +127,21 @@ def add_recorder(params: dict[str, Any], output: str, storage: str) -> None:
         device["wait_for"] = [*wait, "recorder_node"]
 
 
+def add_pinning(params: dict[str, Any]) -> str:
+    """``--pin``: each loop node's ``cpu_affinity`` from the critical-path placement
+    (``haptic_msgs_py.cpus``), unless the config or ``--set`` gave one; returns the plan's text."""
+    from haptic_msgs_py.cpus import available_cpus, describe, placement
+
+    try:
+        assigned = placement([n for n in params if n != "/**"], available_cpus())
+    except ValueError as exc:
+        raise CliError(f"--pin: {exc}") from None
+    for name, cpus in assigned.items():
+        if not params[name].get("cpu_affinity"):
+            params[name]["cpu_affinity"] = cpus
+    return describe({n: params[n]["cpu_affinity"] for n in assigned})
+
+
 def write_params_file(params: dict[str, Any], directory: Path) -> Path:
     """A ``ros__parameters`` file any namespace matches (``/**/<node>`` keys), for this launch."""
     doc = {}
@@ -325,6 +340,7 @@ def command(
     record: str | None = None,
     record_storage: str = "mcap",
     rt_priority: int | None = None,
+    pin: bool = False,
 ) -> int:
     """Resolve, plan and run; raises ``CliError`` on bad input."""
     import tempfile
@@ -334,6 +350,10 @@ def command(
     params = resolved_params(path, parse_sets(sets))
     if record:
         add_recorder(params, record, record_storage)
+    if pin:
+        if composed:
+            raise CliError("--pin places the nodes' processes; --composed runs one process")
+        print(f"haptic-launch: CPUs {add_pinning(params)}", file=sys.stderr)
     net = network_env(network, peers)
     if rt_priority is not None:  # the nodes started below inherit the policy
         set_rt_priority(rt_priority)
@@ -413,6 +433,13 @@ def main(argv: list[str] | None = None) -> int:
         help="run the nodes with real-time scheduling, SCHED_FIFO priority P (1-99; Linux, needs "
         "root or CAP_SYS_NICE): fewer late commands in real time (BENCHMARKS.md)",
     )
+    p.add_argument(
+        "--pin",
+        action="store_true",
+        help="pin each loop node's process to a CPU (its cpu_affinity): device and controller "
+        "on one, environment and observer on another (one each with 4+ CPUs); faster lockstep, "
+        "fewer late commands on an otherwise idle machine (BENCHMARKS.md)",
+    )
     a = p.parse_args(argv)
     only = [n for n in a.only.split(",") if n]
     peers = [h for h in a.peers.split(",") if h]
@@ -431,6 +458,7 @@ def main(argv: list[str] | None = None) -> int:
             a.record,
             a.record_storage,
             a.rt_priority,
+            a.pin,
         )
     )
 

@@ -253,6 +253,11 @@ class SimulatedArm:
         """The current sample k."""
         return self._sample
 
+    def prepare(self) -> None:
+        """Do ahead the work the next ``apply`` would otherwise do first (the hand's next block)."""
+        for ref, _ in self._ref:
+            ref.prepare(self._i_phys + self.substeps - 1)
+
     def apply(self, effort: list[float] | tuple[float, ...]) -> None:
         """Hold ``effort`` (saturated per joint) over [k, k+1) and step to k+1.
 

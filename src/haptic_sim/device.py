@@ -45,3 +45,7 @@ class SimulatedDevice(Protocol):
     def sample(self) -> DeviceSample: ...
 
     def apply(self, effort: list[float] | tuple[float, ...]) -> None: ...
+
+    def prepare(self) -> None:
+        """Optional work ahead of the next ``apply`` (changes no sample; a real-time device calls it
+        while it waits for a command)."""

@@ -117,6 +117,11 @@ class SimulatedSlide:
         """The current sample k."""
         return self._sample
 
+    def prepare(self) -> None:
+        """Do ahead the work the next ``apply`` would otherwise do first (the hand's next block)."""
+        if self.hand.active:
+            self._reference.prepare(self._i_phys + self.substeps - 1)
+
     def apply(self, effort: list[float] | tuple[float, ...]) -> None:
         """Hold ``effort`` (N, length 1; saturated at max_force_n) over [k, k+1) and step to k+1.
 

@@ -19,6 +19,19 @@ def loop_specs() -> list[ParamSpec]:
     ]
 
 
+def process_specs() -> list[ParamSpec]:
+    """Per-process settings of a loop node (``cpu_affinity``)."""
+    return [
+        ParamSpec(
+            "cpu_affinity",
+            [],
+            "CPUs this node's process runs on, every thread (as ros2_control's cpu_affinity); "
+            "[] = wherever the system schedules it. haptic-launch --pin fills it per node",
+            read_only=True,
+        )
+    ]
+
+
 def main_for(node_class: type, args: list[str] | None = None) -> int:
     """``main()`` of a single-node executable: spin it until Ctrl-C/SIGTERM."""
     from haptic_msgs_py.ament import ensure_ament_prefix

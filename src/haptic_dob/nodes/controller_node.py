@@ -34,7 +34,7 @@ from rclpy.context import Context
 
 from haptic_dob.control import ZERO_FORCE, ControlMode, ImpedanceController, ImpedanceLaw
 from haptic_dob.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import loop_specs, main_for
+from haptic_dob.nodes.common import loop_specs, main_for, process_specs
 from haptic_dob.nodes.observer_node import JointMap, pick
 from haptic_msgs_py import wire
 from haptic_msgs_py.convert import read_force
@@ -86,6 +86,7 @@ def controller_node_specs() -> list[ParamSpec]:
     """Every parameter of the controller node."""
     return [
         *loop_specs(),
+        *process_specs(),
         *model_specs(),
         *specs_of(ImpedanceLaw),
         ParamSpec(

@@ -9,7 +9,7 @@ from typing import Any
 from rclpy.context import Context
 
 from haptic_dob.environment import VirtualWall
-from haptic_dob.nodes.common import loop_specs, main_for
+from haptic_dob.nodes.common import loop_specs, main_for, process_specs
 from haptic_msgs_py import wire
 from haptic_msgs_py.convert import read_linear, read_position, write_force
 from haptic_msgs_py.params import ParamSpec, build, specs_of
@@ -23,7 +23,7 @@ from haptic_msgs_py.topics import EE_POSE, EE_TWIST, SESSION_TOPICS, WRENCH_DESI
 
 def environment_node_specs() -> list[ParamSpec]:
     """Every parameter of the environment node (the wall's change at run time)."""
-    return [*loop_specs(), *specs_of(VirtualWall)]
+    return [*loop_specs(), *process_specs(), *specs_of(VirtualWall)]
 
 
 class EnvironmentNode(LoopNode):

@@ -19,7 +19,7 @@ from std_srvs.srv import Trigger
 
 from haptic_dob.models.base import DeviceModel
 from haptic_dob.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import loop_specs, main_for
+from haptic_dob.nodes.common import loop_specs, main_for, process_specs
 from haptic_dob.observer import DisturbanceObserver, ObserverSettings
 from haptic_msgs_py import wire
 from haptic_msgs_py.convert import write_force
@@ -74,7 +74,7 @@ def pick(values: Any, index: list[int], what: str, n_names: int) -> list[float]:
 
 def observer_node_specs() -> list[ParamSpec]:
     """Every parameter of the observer node."""
-    return [*loop_specs(), *model_specs(), *specs_of(ObserverSettings)]
+    return [*loop_specs(), *process_specs(), *model_specs(), *specs_of(ObserverSettings)]
 
 
 class ObserverNode(LoopNode):

@@ -31,6 +31,8 @@ from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
+from haptic_msgs_py.cpus import checked_cpus, pin_process
+
 EXECUTORS = ("events", "single")
 DRAIN_BUDGET_S = 2.0  # at most this long for the work-off and the acknowledgements at a stop
 DRAIN_QUIET_S = 0.2  # inputs are worked off when the marker did not change for this long
@@ -56,6 +58,24 @@ class LoopNode(Node):
     def drain_marker(self) -> int | None:
         """A value that changes while the node works off inputs; None: do not drain at a stop."""
         return None
+
+    def cpu_affinity(self) -> list[float]:
+        """The CPUs its ``cpu_affinity`` parameter asks for ([] = not pinned)."""
+        params = getattr(self, "params", None)
+        return list(params.values.get("cpu_affinity", [])) if params is not None else []
+
+
+def pin_to_asked_cpus(nodes: Sequence[Node]) -> None:
+    """Pin this process to the CPUs its loop nodes ask for (their union; none asked: no change).
+
+    ``ValueError`` with the reason when a CPU is not usable.
+    """
+    asked = [c for n in nodes if isinstance(n, LoopNode) for c in n.cpu_affinity()]
+    if not asked:
+        return
+    cpus = checked_cpus(asked)
+    pin_process(cpus)
+    nodes[0].get_logger().info(f"process pinned to CPU {', '.join(map(str, cpus))}")
 
 
 def make_executor(kind: str, context: Context) -> Executor:
@@ -101,6 +121,7 @@ def run_nodes(
     try:
         try:
             nodes = list(make_nodes(context))
+            pin_to_asked_cpus(nodes)
         except InvalidParameterValueException as exc:
             text = " ".join(str(exc).split())  # "... Reason: <reason>: <name>"
             reason, _, name = (text.partition("Reason: ")[2] or text).rpartition(": ")

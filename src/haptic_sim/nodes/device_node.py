@@ -38,7 +38,7 @@ import numpy as np
 from rclpy.context import Context
 
 from haptic_dob.models.factory import model_specs
-from haptic_dob.nodes.common import CLOCK_MODES, loop_specs, main_for
+from haptic_dob.nodes.common import CLOCK_MODES, loop_specs, main_for, process_specs
 from haptic_msgs_py import wire
 from haptic_msgs_py.convert import write_force, write_linear, write_position
 from haptic_msgs_py.params import ParamSpec
@@ -87,6 +87,7 @@ def device_node_specs() -> list[ParamSpec]:
             "saturation; [0.0] = the actuator's saturation",
         ),
         *loop_specs(),
+        *process_specs(),
         *model_specs(),
         ParamSpec(
             "clock_mode",
@@ -312,6 +313,7 @@ class DeviceNode(LoopNode):
             self._command_k = self.device.k
             self._on_time += 1
             self._latency.add(now - self._sent_s)
+            self.device.prepare()  # the loop is idle until the next tick
 
     def _on_progress(self, msg: Any) -> None:
         st = msg.stamp
@@ -340,6 +342,7 @@ class DeviceNode(LoopNode):
         self._publish(s)
         self.diagnostics.tick()
         if self.lockstep:
+            self.device.prepare()  # while the others work on sample k
             self._deadline = self._sent_s + self.params.values["lockstep_timeout_s"]
         if self.last_k is not None and s.k >= self.last_k and self._drain_until is None:
             wall = time.monotonic() - self._t_first

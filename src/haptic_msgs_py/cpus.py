@@ -1,0 +1,82 @@
+"""CPU affinity of a node process, and where the loop's nodes go when a launch pins them.
+
+A lockstep cycle is a chain device -> environment -> controller -> device, with the observer
+beside it. On a 2-core machine the scheduler moves the four processes between the cores at every
+hand-over, and each move costs the process its warm caches. Pinning the device and the controller
+(which never run at the same time in a cycle) to one CPU and the environment and the observer to
+the other keeps every process on warm caches: the measured lockstep real-time factor goes from
+about 1.9 to about 2.5 on the 2-core machine of BENCHMARKS.md. As in ros2_control's controller
+manager (its ``cpu_affinity`` parameter), pinning is asked for, never the default: a pinned process
+cannot move away from a core that other work occupies.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Mapping, Sequence
+
+#: the loop's nodes sharing one CPU when only two are available (the critical-path pairs)
+PAIRS = (("device_node", "controller_node"), ("environment_node", "observer_node"))
+
+
+def available_cpus() -> list[int]:
+    """The CPUs this process may run on (all of them, where the system cannot say)."""
+    if hasattr(os, "sched_getaffinity"):
+        return sorted(os.sched_getaffinity(0))
+    return list(range(os.cpu_count() or 1))
+
+
+def checked_cpus(values: Iterable[float | int]) -> list[int]:
+    """``values`` as sorted CPU numbers; ``ValueError`` with the reason if one is not usable."""
+    cpus: set[int] = set()
+    for v in values:
+        if isinstance(v, bool) or float(v) != int(v) or int(v) < 0:
+            raise ValueError(f"cpu_affinity: {v!r} is not a CPU number (an integer >= 0)")
+        cpus.add(int(v))
+    usable = available_cpus()
+    missing = sorted(cpus.difference(usable))
+    if missing:
+        raise ValueError(
+            f"cpu_affinity: CPU {', '.join(map(str, missing))} not available to this process "
+            f"(available: {', '.join(map(str, usable))})"
+        )
+    return sorted(cpus)
+
+
+def pin_process(cpus: Sequence[int]) -> None:
+    """Run every thread of this process (and the threads it starts later) on ``cpus``.
+
+    The middleware's threads already exist when the parameters are known, so each one is pinned
+    (Linux: ``/proc/self/task``); threads started later inherit the affinity of their creator.
+    """
+    if not hasattr(os, "sched_setaffinity"):
+        raise ValueError("cpu_affinity: this system cannot pin processes to CPUs (Linux only)")
+    wanted = set(cpus)
+    try:
+        threads = [int(t) for t in os.listdir("/proc/self/task")]
+    except OSError:
+        threads = [0]
+    for tid in threads:
+        try:
+            os.sched_setaffinity(tid, wanted)
+        except ProcessLookupError:  # the thread ended meanwhile
+            continue
+
+
+def placement(nodes: Iterable[str], cpus: Sequence[int]) -> dict[str, list[int]]:
+    """The CPU of each loop node of ``nodes`` when a launch pins them (other nodes stay free).
+
+    Four or more CPUs: one each. Two or three: the pairs of ``PAIRS`` share a CPU. One: nothing
+    to place (``ValueError``).
+    """
+    loop = [n for pair in PAIRS for n in pair if n in set(nodes)]
+    if len(cpus) < 2:
+        raise ValueError(f"pinning needs at least 2 CPUs, this process may use {len(cpus)}")
+    if len(cpus) >= 4:
+        return {n: [cpus[i]] for i, n in enumerate(loop)}
+    return {n: [cpus[i]] for i, pair in enumerate(PAIRS) for n in pair if n in loop}
+
+
+def describe(assigned: Mapping[str, Sequence[int]]) -> str:
+    """``device_node: 0, controller_node: 0, ...`` for a log line."""
+    return ", ".join(f"{n}: {','.join(map(str, c))}" for n, c in assigned.items())
