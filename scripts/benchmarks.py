@@ -83,8 +83,14 @@ def _launch(extra: list[str], sets: list[str], timeout: float) -> str:
     return out.stdout + out.stderr
 
 
-#: extra ``haptic-launch`` arguments of the graph benchmarks (``--set``, ``--rt-priority``)
+#: extra ``haptic-launch`` arguments of the graph benchmarks (--set, --rt-priority, --pin)
 GRAPH_ARGS: list[str] = []
+
+
+def graph_args(extra: list[str]) -> list[str]:
+    """A benchmark's arguments and ``GRAPH_ARGS``; one process (``--composed``) is not pinned."""
+    args = [*extra, *GRAPH_ARGS]
+    return [a for a in args if a != "--pin"] if "--composed" in args else args
 
 
 def _lockstep(repeat: int, extra: list[str]) -> str:
@@ -92,7 +98,7 @@ def _lockstep(repeat: int, extra: list[str]) -> str:
 
     rtf = []
     for _ in range(repeat):
-        text = _launch([*extra, *GRAPH_ARGS], ["device_node:duration_s=20.0"], 300)
+        text = _launch(graph_args(extra), ["device_node:duration_s=20.0"], 300)
         rtf.append(float(re.search(r"real-time factor ([0-9.]+)", text).group(1)))
     per_cycle_us = 1e3 / statistics.median(rtf)
     return (
@@ -120,7 +126,7 @@ def _realtime(repeat: int, extra: list[str]) -> str:
         with tempfile.TemporaryDirectory() as tmp:
             stats = os.path.join(tmp, "stats.json")
             _launch(
-                [*extra, *GRAPH_ARGS],
+                graph_args(extra),
                 [
                     "device_node:clock_mode=realtime",
                     "device_node:duration_s=20.0",

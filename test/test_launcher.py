@@ -294,10 +294,24 @@ def test_pin_on_one_cpu_is_one_line(monkeypatch) -> None:
         launcher.add_pinning({"device_node": {}, "controller_node": {}})
 
 
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="--pin needs 2 CPUs")
 def test_pin_keeps_an_affinity_the_config_gives() -> None:
     from haptic_dob.launcher import add_pinning
 
     params = {"/**": {}, "device_node": {"cpu_affinity": [1]}, "environment_node": {}}
-    add_pinning(params)
+    assert "device_node: 1" in add_pinning(params)
     assert params["device_node"]["cpu_affinity"] == [1]
     assert params["environment_node"]["cpu_affinity"] and "cpu_affinity" not in params["/**"]
+    common = {"/**": {"cpu_affinity": [0]}, "device_node": {}, "observer_node": {}}
+    assert add_pinning(common) == "device_node: 0, observer_node: 0"  # every node's, kept
+    assert "cpu_affinity" not in common["device_node"]
+
+
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="--pin needs 2 CPUs")
+@pytest.mark.parametrize("given", [1, "0", True])
+def test_pin_refuses_a_cpu_affinity_that_is_no_list(given) -> None:
+    from haptic_dob.cli import CliError
+    from haptic_dob.launcher import add_pinning
+
+    with pytest.raises(CliError, match="cpu_affinity of device_node must be a list of CPU"):
+        add_pinning({"device_node": {"cpu_affinity": given}})

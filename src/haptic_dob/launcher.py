@@ -129,17 +129,24 @@ def add_recorder(params: dict[str, Any], output: str, storage: str) -> None:
 
 def add_pinning(params: dict[str, Any]) -> str:
     """``--pin``: each loop node's ``cpu_affinity`` from the critical-path placement
-    (``haptic_msgs_py.cpus``), unless the config or ``--set`` gave one; returns the plan's text."""
+    (``haptic_msgs_py.cpus``), unless the config (its node section or ``/**``) or ``--set`` gave
+    one; returns the plan's text."""
     from haptic_msgs_py.cpus import available_cpus, describe, placement
 
     try:
         assigned = placement([n for n in params if n != "/**"], available_cpus())
     except ValueError as exc:
         raise CliError(f"--pin: {exc}") from None
+    common = params.get("/**", {}).get("cpu_affinity")
     for name, cpus in assigned.items():
-        if not params[name].get("cpu_affinity"):
+        given = params[name].get("cpu_affinity", common)
+        if given is not None and not isinstance(given, list):
+            raise CliError(f"cpu_affinity of {name} must be a list of CPU numbers, got {given!r}")
+        if given:
+            assigned[name] = given
+        else:
             params[name]["cpu_affinity"] = cpus
-    return describe({n: params[n]["cpu_affinity"] for n in assigned})
+    return describe(assigned)
 
 
 def write_params_file(params: dict[str, Any], directory: Path) -> Path:

@@ -12,6 +12,7 @@ cannot move away from a core that other work occupies.
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Iterable, Mapping, Sequence
 
@@ -52,15 +53,18 @@ def pin_process(cpus: Sequence[int]) -> None:
     if not hasattr(os, "sched_setaffinity"):
         raise ValueError("cpu_affinity: this system cannot pin processes to CPUs (Linux only)")
     wanted = set(cpus)
-    try:
-        threads = [int(t) for t in os.listdir("/proc/self/task")]
-    except OSError:
-        threads = [0]
-    for tid in threads:
+    done: set[int] = set()
+    while True:  # again while threads appear (one not yet pinned may start another)
         try:
-            os.sched_setaffinity(tid, wanted)
-        except ProcessLookupError:  # the thread ended meanwhile
-            continue
+            threads = {int(t) for t in os.listdir("/proc/self/task")} - done
+        except OSError:
+            threads = {0} - done
+        if not threads:
+            return
+        for tid in threads:
+            with contextlib.suppress(ProcessLookupError):  # the thread ended meanwhile
+                os.sched_setaffinity(tid, wanted)
+        done |= threads
 
 
 def placement(nodes: Iterable[str], cpus: Sequence[int]) -> dict[str, list[int]]:
@@ -69,7 +73,8 @@ def placement(nodes: Iterable[str], cpus: Sequence[int]) -> dict[str, list[int]]
     Four or more CPUs: one each. Two or three: the pairs of ``PAIRS`` share a CPU. One: nothing
     to place (``ValueError``).
     """
-    loop = [n for pair in PAIRS for n in pair if n in set(nodes)]
+    present = set(nodes)
+    loop = [n for pair in PAIRS for n in pair if n in present]
     if len(cpus) < 2:
         raise ValueError(f"pinning needs at least 2 CPUs, this process may use {len(cpus)}")
     if len(cpus) >= 4:
