@@ -13,6 +13,7 @@ import statistics
 import sys
 import time
 from collections.abc import Callable
+from multiprocessing import Queue
 
 
 def machine() -> str:
@@ -83,7 +84,8 @@ def _launch(extra: list[str], sets: list[str], timeout: float) -> str:
     return out.stdout + out.stderr
 
 
-#: extra ``haptic-launch`` arguments of the graph benchmarks (--set, --rt-priority, --pin)
+#: extra ``haptic-launch`` arguments of the graph benchmarks (--set, --rt-priority, --pin,
+#: --cpu-latency)
 GRAPH_ARGS: list[str] = []
 
 
@@ -159,6 +161,83 @@ def bench_realtime_composed(repeat: int) -> str:
     return _realtime(repeat, ["--composed"])
 
 
+FLOOR_S = 20.0  # length of one timer-floor run (s), as the real-time graph runs
+FLOOR_BUDGET_S = 0.5e-3  # a tick woken later than this counts as lost (s)
+
+
+def _floor_loop(cpu: int, t0: float, priority: int | None, out: Queue) -> None:
+    """Wake at every 1 ms tick from ``t0`` on ``cpu``; put the indices of ticks woken late.
+
+    No work, no resynchronisation: after a stall the loop wakes at once for every tick it
+    overslept, so a stall of L ms shows as about L late ticks, as a stalled node makes a burst.
+    """
+    os.sched_setaffinity(0, {cpu})
+    if priority is not None:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    n = int(FLOOR_S * 1e3)
+    late: list[int] = []
+    longest = 0.0
+    monotonic, sleep = time.monotonic, time.sleep
+    for k in range(n):
+        due = t0 + k * 1e-3
+        while (left := due - monotonic()) > 0.0:
+            sleep(left)
+        lateness = monotonic() - due
+        longest = max(longest, lateness)
+        if lateness > FLOOR_BUDGET_S:
+            late.append(k)
+    out.put((cpu, late, longest))
+
+
+def bench_timer_floor(repeat: int) -> str:
+    """What this machine allows any 1 kHz loop: one idle loop per CPU waking at every tick.
+
+    A tick is lost when a CPU's loop woke more than ``FLOOR_BUDGET_S`` late (the graph's loop
+    needs about 0.4 ms of its 1 ms period, on both CPUs). Uses ``--rt-priority`` and
+    ``--cpu-latency`` when given (one loop per CPU, pinned, as ``--pin`` places the nodes).
+    """
+    import multiprocessing
+
+    from haptic_msgs_py.cpu_latency import hold
+
+    ctx = multiprocessing.get_context("spawn")
+    prio = latency = None
+    if "--rt-priority" in GRAPH_ARGS:
+        prio = int(GRAPH_ARGS[GRAPH_ARGS.index("--rt-priority") + 1])
+    if "--cpu-latency" in GRAPH_ARGS:
+        latency = int(GRAPH_ARGS[GRAPH_ARGS.index("--cpu-latency") + 1])
+    fd = None if latency is None else hold(latency)
+    cpus = sorted(os.sched_getaffinity(0))
+    n = int(FLOOR_S * 1e3)
+    shares, longest, stalls, per_cpu = [], [], [], []
+    for _ in range(repeat):
+        out = ctx.Queue()
+        t0 = time.monotonic() + 1.0  # every loop started and pinned by then
+        procs = [ctx.Process(target=_floor_loop, args=(c, t0, prio, out)) for c in cpus]
+        for pr in procs:
+            pr.start()
+        results = [out.get(timeout=FLOOR_S + 60.0) for _ in procs]
+        for pr in procs:
+            pr.join(timeout=10.0)
+        lost = set().union(*(set(late) for _, late, _ in results))
+        shares.append(100.0 * (n - len(lost)) / n)
+        longest.append(max(m for _, _, m in results) * 1e3)
+        stalls.append(len(lost))
+        by_cpu = sorted((cpu, len(late)) for cpu, late, _ in results)
+        per_cpu.append("/".join(str(count) for _, count in by_cpu))
+    if fd is not None:
+        os.close(fd)
+    held = "" if latency is None else f", CPU latency {latency} us held"
+    return (
+        f"ticks no CPU woke more than {FLOOR_BUDGET_S * 1e3:g} ms late: median "
+        f"{statistics.median(shares):.2f} % (runs: {', '.join(f'{s:.2f}' for s in shares)}); "
+        f"lost ticks {', '.join(map(str, stalls))} (per CPU {', '.join(per_cpu)}); longest stall "
+        "per run "
+        f"{', '.join(f'{m:.1f}' for m in longest)} ms ({len(cpus)} CPUs, "
+        f"{'SCHED_FIFO ' + str(prio) if prio else 'default scheduling'}{held})"
+    )
+
+
 BENCHMARKS: dict[str, Callable[[int], str]] = {
     "batch": bench_batch_session,
     "observer": bench_observer_update,
@@ -166,6 +245,7 @@ BENCHMARKS: dict[str, Callable[[int], str]] = {
     "lockstep-composed": bench_lockstep_composed,
     "realtime": bench_realtime,
     "realtime-composed": bench_realtime_composed,
+    "timer-floor": bench_timer_floor,
 }
 
 
@@ -192,18 +272,31 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="pin the graph benchmarks' node processes to CPUs (haptic-launch option)",
     )
+    p.add_argument(
+        "--cpu-latency",
+        type=int,
+        metavar="US",
+        help="hold a CPU wake-up latency request of US microseconds while the graph benchmarks "
+        "and timer-floor run (haptic-launch option; PM QoS, needs root)",
+    )
     a = p.parse_args(argv)
     GRAPH_ARGS[:] = [x for item in a.set for x in ("--set", item)]
     if a.rt_priority is not None:
         GRAPH_ARGS.extend(["--rt-priority", str(a.rt_priority)])
     if a.pin:
         GRAPH_ARGS.append("--pin")
+    if a.cpu_latency is not None:
+        GRAPH_ARGS.extend(["--cpu-latency", str(a.cpu_latency)])
     unknown = [n for n in a.names if n not in BENCHMARKS]
     if unknown:
         p.error(f"unknown benchmark(s) {', '.join(unknown)}; choose from {', '.join(BENCHMARKS)}")
     print(f"machine: {machine()}")
     for name in a.names or list(BENCHMARKS):
-        print(f"{name}: {BENCHMARKS[name](a.repeat)}", flush=True)
+        try:
+            print(f"{name}: {BENCHMARKS[name](a.repeat)}", flush=True)
+        except (RuntimeError, ValueError) as exc:  # a launch that failed, a refused request
+            print(f"ERROR: {name}: {' '.join(str(exc).split())}", file=sys.stderr)
+            return 1
     return 0
 
 

@@ -32,3 +32,10 @@ def _no_ros_domain_leak(monkeypatch: pytest.MonkeyPatch) -> None:
         "ROS_AUTOMATIC_DISCOVERY_RANGE",
         os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST"),
     )
+
+
+def can_request_cpu_latency() -> bool:
+    """Whether this test run may make PM QoS requests (write access to the device, root)."""
+    from haptic_msgs_py.cpu_latency import PM_QOS_PATH
+
+    return os.path.exists(PM_QOS_PATH) and os.access(PM_QOS_PATH, os.R_OK | os.W_OK)

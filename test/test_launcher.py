@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import tool
+from conftest import can_request_cpu_latency, tool
 from haptic_msgs_py.topics import JOINT_STATES, SESSION_TOPICS
 from haptic_sim.session import SessionConfig, run_session
 from rosgraph import Collector, isolated_env, launch
@@ -282,6 +282,45 @@ def test_an_unusable_cpu_affinity_stops_the_graph_with_its_reason() -> None:
     assert out.returncode == 1
     assert "ERROR: cpu_affinity: CPU 4096 not available to this process" in out.stderr
     assert "device_node exited with code 2" in out.stderr and "Traceback" not in out.stderr
+
+
+@pytest.mark.multiprocess
+@pytest.mark.skipif(not can_request_cpu_latency(), reason="PM QoS requests need root")
+def test_cpu_latency_is_held_while_the_graph_runs_and_withdrawn_after(tmp_path) -> None:
+    """Each loop node process holds the request; the kernel applies it until the graph stops."""
+    from haptic_msgs_py.cpu_latency import current
+
+    before = current()
+    log = tmp_path / "launch.log"
+    proc = launch(
+        "slide_sim",
+        isolated_env(),
+        ["device_node:clock_mode=realtime", "device_node:duration_s=0.0"],
+        log,
+        ["--cpu-latency", "0"],
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and log.read_text().count("held at 0 us") < 4:
+            assert proc.proc.poll() is None, log.read_text()
+            time.sleep(0.2)
+        text = log.read_text()
+        for name in NODE_NAMES.values():
+            assert f"[{name}]: CPU wake-up latency held at 0 us" in text, text
+        assert current() == 0
+    finally:
+        code = proc.stop()
+    assert code == 0, log.read_text()
+    assert current() == before  # every process closed its request
+
+
+@pytest.mark.multiprocess
+@pytest.mark.skipif(can_request_cpu_latency(), reason="this run may make PM QoS requests")
+def test_cpu_latency_without_access_stops_the_graph_with_its_reason() -> None:
+    out = launch_cli("slide_sim", "--cpu-latency", "0")
+    assert out.returncode == 1
+    assert "ERROR: cpu_latency_us: cannot open /dev/cpu_dma_latency" in out.stderr
+    assert "exited with code 2" in out.stderr and "Traceback" not in out.stderr
 
 
 def test_pin_on_one_cpu_is_one_line(monkeypatch) -> None:

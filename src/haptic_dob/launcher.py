@@ -4,7 +4,8 @@ Every node section of the YAML (``device_node``, ``environment_node``, ``observe
 ``controller_node``, ``recorder_node``) starts as its own process through the ``ros2 run``
 contract (``<prefix>/lib/<pkg>/<exe>`` found with ``ament_index_python``), with
 ``--ros-args --params-file CONFIG`` and the namespace. The device starts last. Ctrl-C or SIGTERM
-is forwarded to every node as SIGINT (each shuts down cleanly: the device zeroes its effort) and
+is forwarded to every node as SIGTERM (each shuts down cleanly: the device zeroes its effort; a
+node still starting up ends quietly, with no Python traceback as SIGINT would give) and
 the launcher waits for them, killing what is still alive after ``--stop-timeout``. When the
 device finishes a lockstep run (``duration_s``) the others are stopped too. ``--composed`` runs
 all nodes in this one process under one executor instead.
@@ -149,6 +150,19 @@ def add_pinning(params: dict[str, Any]) -> str:
     return describe(assigned)
 
 
+def add_cpu_latency(params: dict[str, Any], latency_us: int) -> None:
+    """``--cpu-latency``: each loop node's ``cpu_latency_us``, unless the config or ``--set``
+    gave one (its node section or ``/**``)."""
+    from haptic_msgs_py.cpus import PAIRS
+
+    if not 0 <= latency_us <= 1_000_000:
+        raise CliError(f"--cpu-latency {latency_us}: must be 0 to 1000000 us (0: idle CPUs poll)")
+    common = params.get("/**", {}).get("cpu_latency_us")
+    for name in (n for pair in PAIRS for n in pair if n in params):
+        if params[name].get("cpu_latency_us", common) is None:
+            params[name]["cpu_latency_us"] = latency_us
+
+
 def write_params_file(params: dict[str, Any], directory: Path) -> Path:
     """A ``ros__parameters`` file any namespace matches (``/**/<node>`` keys), for this launch."""
     doc = {}
@@ -254,12 +268,16 @@ def launch(
 
 
 def _stop_all(procs: dict[str, subprocess.Popen], timeout: float) -> None:
-    """SIGINT to every live node (device first), wait, then SIGKILL what is left."""
+    """SIGTERM to every live node (device first), wait, then SIGKILL what is left.
+
+    A node that runs handles SIGTERM as Ctrl-C (``run_nodes``); one still importing its modules
+    ends quietly, where SIGINT would print a ``KeyboardInterrupt`` traceback.
+    """
     order = sorted(procs, key=lambda n: n != "device_node")
     for name in order:
         p = procs[name]
         if p.poll() is None:
-            p.send_signal(signal.SIGINT)
+            p.send_signal(signal.SIGTERM)
     deadline = time.monotonic() + timeout
     for name in order:
         p = procs[name]
@@ -348,6 +366,7 @@ def command(
     record_storage: str = "mcap",
     rt_priority: int | None = None,
     pin: bool = False,
+    cpu_latency_us: int | None = None,
 ) -> int:
     """Resolve, plan and run; raises ``CliError`` on bad input."""
     import tempfile
@@ -361,6 +380,8 @@ def command(
         if composed:
             raise CliError("--pin places the nodes' processes; --composed runs one process")
         print(f"haptic-launch: CPUs {add_pinning(params)}", file=sys.stderr)
+    if cpu_latency_us is not None:
+        add_cpu_latency(params, cpu_latency_us)
     net = network_env(network, peers)
     if rt_priority is not None:  # the nodes started below inherit the policy
         set_rt_priority(rt_priority)
@@ -447,6 +468,14 @@ def main(argv: list[str] | None = None) -> int:
         "on one, environment and observer on another (one each with 4+ CPUs); faster lockstep, "
         "fewer late commands on an otherwise idle machine (BENCHMARKS.md)",
     )
+    p.add_argument(
+        "--cpu-latency",
+        type=int,
+        metavar="US",
+        help="while the nodes run, CPUs wake from idle within US microseconds (their "
+        "cpu_latency_us; Linux PM QoS, needs root): 0 makes idle CPUs poll, which speeds up every "
+        "hand-over on a virtual machine (BENCHMARKS.md) and costs power",
+    )
     a = p.parse_args(argv)
     only = [n for n in a.only.split(",") if n]
     peers = [h for h in a.peers.split(",") if h]
@@ -466,6 +495,7 @@ def main(argv: list[str] | None = None) -> int:
             a.record_storage,
             a.rt_priority,
             a.pin,
+            a.cpu_latency,
         )
     )
 

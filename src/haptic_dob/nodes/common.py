@@ -20,7 +20,7 @@ def loop_specs() -> list[ParamSpec]:
 
 
 def process_specs() -> list[ParamSpec]:
-    """Per-process settings of a loop node (``cpu_affinity``)."""
+    """Per-process settings of a loop node (``cpu_affinity``, ``cpu_latency_us``)."""
     return [
         ParamSpec(
             "cpu_affinity",
@@ -28,7 +28,19 @@ def process_specs() -> list[ParamSpec]:
             "CPUs this node's process runs on, every thread (as ros2_control's cpu_affinity); "
             "[] = wherever the system schedules it. haptic-launch --pin fills it per node",
             read_only=True,
-        )
+        ),
+        ParamSpec(
+            "cpu_latency_us",
+            -1,
+            "while this process runs, CPUs wake from idle within this bound (Linux PM QoS "
+            "request on /dev/cpu_dma_latency, held open; needs write access to it, root as a "
+            "rule): 0 = idle CPUs poll and wake at once (costs power). -1 = no request. "
+            "haptic-launch --cpu-latency sets it on every loop node",
+            unit="us",
+            min=-1,
+            max=1_000_000,
+            read_only=True,
+        ),
     ]
 
 

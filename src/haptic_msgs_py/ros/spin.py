@@ -31,6 +31,7 @@ from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
+from haptic_msgs_py.cpu_latency import NO_REQUEST, hold, strictest
 from haptic_msgs_py.cpus import checked_cpus, pin_process
 
 EXECUTORS = ("events", "single")
@@ -64,6 +65,13 @@ class LoopNode(Node):
         params = getattr(self, "params", None)
         return list(params.values.get("cpu_affinity", [])) if params is not None else []
 
+    def cpu_latency_us(self) -> int:
+        """The CPU wake-up bound its ``cpu_latency_us`` parameter asks for (-1 = none), us."""
+        params = getattr(self, "params", None)
+        if params is None:
+            return NO_REQUEST
+        return int(params.values.get("cpu_latency_us", NO_REQUEST))
+
 
 def pin_to_asked_cpus(nodes: Sequence[Node]) -> None:
     """Pin this process to the CPUs its loop nodes ask for (their union; none asked: no change).
@@ -76,6 +84,19 @@ def pin_to_asked_cpus(nodes: Sequence[Node]) -> None:
     cpus = checked_cpus(asked)
     pin_process(cpus)
     nodes[0].get_logger().info(f"process pinned to CPU {', '.join(map(str, cpus))}")
+
+
+def hold_asked_cpu_latency(nodes: Sequence[Node]) -> int | None:
+    """Hold the strictest ``cpu_latency_us`` its loop nodes ask for; the descriptor, or None.
+
+    ``ValueError`` with the reason when the request cannot be made.
+    """
+    bound = strictest([n.cpu_latency_us() for n in nodes if isinstance(n, LoopNode)])
+    if bound == NO_REQUEST:
+        return None
+    fd = hold(bound)
+    nodes[0].get_logger().info(f"CPU wake-up latency held at {bound} us (PM QoS) while it runs")
+    return fd
 
 
 def make_executor(kind: str, context: Context) -> Executor:
@@ -118,10 +139,12 @@ def run_nodes(
 
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     nodes: list[Node] = []
+    latency_fd: int | None = None
     try:
         try:
             nodes = list(make_nodes(context))
             pin_to_asked_cpus(nodes)
+            latency_fd = hold_asked_cpu_latency(nodes)
         except InvalidParameterValueException as exc:
             text = " ".join(str(exc).split())  # "... Reason: <reason>: <name>"
             reason, _, name = (text.partition("Reason: ")[2] or text).rpartition(": ")
@@ -182,6 +205,8 @@ def run_nodes(
         for n in nodes:
             n.destroy_node()
         rclpy.try_shutdown(context=context)
+        if latency_fd is not None:  # the request ends with the loop
+            os.close(latency_fd)
         for s, h in old.items():
             signal.signal(s, h)
 
