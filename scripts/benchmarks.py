@@ -13,7 +13,7 @@ import statistics
 import sys
 import time
 from collections.abc import Callable
-from multiprocessing import Queue
+from typing import Any
 
 
 def machine() -> str:
@@ -165,7 +165,7 @@ FLOOR_S = 20.0  # length of one timer-floor run (s), as the real-time graph runs
 FLOOR_BUDGET_S = 0.5e-3  # a tick woken later than this counts as lost (s)
 
 
-def _floor_loop(cpu: int, t0: float, priority: int | None, out: Queue) -> None:
+def _floor_loop(cpu: int, t0: float, priority: int | None, out: Any) -> None:
     """Wake at every 1 ms tick from ``t0`` on ``cpu``; put the indices of ticks woken late.
 
     No work, no resynchronisation: after a stall the loop wakes at once for every tick it
@@ -197,6 +197,7 @@ def bench_timer_floor(repeat: int) -> str:
     ``--cpu-latency`` when given (one loop per CPU, pinned, as ``--pin`` places the nodes).
     """
     import multiprocessing
+    import queue
 
     from haptic_msgs_py.cpu_latency import hold
 
@@ -206,27 +207,41 @@ def bench_timer_floor(repeat: int) -> str:
         prio = int(GRAPH_ARGS[GRAPH_ARGS.index("--rt-priority") + 1])
     if "--cpu-latency" in GRAPH_ARGS:
         latency = int(GRAPH_ARGS[GRAPH_ARGS.index("--cpu-latency") + 1])
-    fd = None if latency is None else hold(latency)
+    if prio is not None:  # refused here with the reason, not in each loop's process
+        before = os.sched_getscheduler(0), os.sched_getparam(0)
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(prio))
+        except (OSError, ValueError) as exc:
+            raise ValueError(f"SCHED_FIFO priority {prio} refused ({exc})") from None
+        os.sched_setscheduler(0, *before)
     cpus = sorted(os.sched_getaffinity(0))
     n = int(FLOOR_S * 1e3)
     shares, longest, stalls, per_cpu = [], [], [], []
-    for _ in range(repeat):
-        out = ctx.Queue()
-        t0 = time.monotonic() + 1.0  # every loop started and pinned by then
-        procs = [ctx.Process(target=_floor_loop, args=(c, t0, prio, out)) for c in cpus]
-        for pr in procs:
-            pr.start()
-        results = [out.get(timeout=FLOOR_S + 60.0) for _ in procs]
-        for pr in procs:
-            pr.join(timeout=10.0)
-        lost = set().union(*(set(late) for _, late, _ in results))
-        shares.append(100.0 * (n - len(lost)) / n)
-        longest.append(max(m for _, _, m in results) * 1e3)
-        stalls.append(len(lost))
-        by_cpu = sorted((cpu, len(late)) for cpu, late, _ in results)
-        per_cpu.append("/".join(str(count) for _, count in by_cpu))
-    if fd is not None:
-        os.close(fd)
+    fd = None if latency is None else hold(latency)
+    try:
+        for _ in range(repeat):
+            out = ctx.Queue()
+            t0 = time.monotonic() + 1.0  # every loop started and pinned by then
+            procs = [ctx.Process(target=_floor_loop, args=(c, t0, prio, out)) for c in cpus]
+            for pr in procs:
+                pr.start()
+            try:
+                results = [out.get(timeout=FLOOR_S + 60.0) for _ in procs]
+            except queue.Empty:
+                codes = [pr.exitcode for pr in procs]
+                raise RuntimeError(f"a timer loop gave no result (exit codes {codes})") from None
+            finally:
+                for pr in procs:
+                    pr.join(timeout=10.0)
+            lost = set().union(*(set(late) for _, late, _ in results))
+            shares.append(100.0 * (n - len(lost)) / n)
+            longest.append(max(m for _, _, m in results) * 1e3)
+            stalls.append(len(lost))
+            by_cpu = sorted((cpu, len(late)) for cpu, late, _ in results)
+            per_cpu.append("/".join(str(count) for _, count in by_cpu))
+    finally:
+        if fd is not None:
+            os.close(fd)
     held = "" if latency is None else f", CPU latency {latency} us held"
     return (
         f"ticks no CPU woke more than {FLOOR_BUDGET_S * 1e3:g} ms late: median "

@@ -35,7 +35,12 @@ def _no_ros_domain_leak(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 def can_request_cpu_latency() -> bool:
-    """Whether this test run may make PM QoS requests (write access to the device, root)."""
+    """Whether this test run may make PM QoS requests: the device opens for writing (root, and
+    no container rule against it). An open without a write makes no request."""
     from haptic_msgs_py.cpu_latency import PM_QOS_PATH
 
-    return os.path.exists(PM_QOS_PATH) and os.access(PM_QOS_PATH, os.R_OK | os.W_OK)
+    try:
+        os.close(os.open(PM_QOS_PATH, os.O_RDWR))
+    except OSError:
+        return False
+    return True

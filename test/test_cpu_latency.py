@@ -48,6 +48,8 @@ def test_a_process_holds_the_strictest_request_of_its_nodes() -> None:
 @pytest.mark.skipif(not can_request_cpu_latency(), reason="PM QoS requests need root")
 def test_the_kernel_applies_a_request_until_it_is_closed() -> None:
     before = current()
+    if before == 0:
+        pytest.skip("another process holds a 0 us request already")
     fd = hold(0)
     try:
         assert current() == 0

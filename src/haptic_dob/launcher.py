@@ -152,15 +152,27 @@ def add_pinning(params: dict[str, Any]) -> str:
 
 def add_cpu_latency(params: dict[str, Any], latency_us: int) -> None:
     """``--cpu-latency``: each loop node's ``cpu_latency_us``, unless the config or ``--set``
-    gave one (its node section or ``/**``)."""
+    gave a request (its node section or ``/**``; -1, no request, counts as not given)."""
+    from haptic_msgs_py.cpu_latency import NO_REQUEST
     from haptic_msgs_py.cpus import PAIRS
 
     if not 0 <= latency_us <= 1_000_000:
         raise CliError(f"--cpu-latency {latency_us}: must be 0 to 1000000 us (0: idle CPUs poll)")
     common = params.get("/**", {}).get("cpu_latency_us")
     for name in (n for pair in PAIRS for n in pair if n in params):
-        if params[name].get("cpu_latency_us", common) is None:
+        if params[name].get("cpu_latency_us", common) in (None, NO_REQUEST):
             params[name]["cpu_latency_us"] = latency_us
+
+
+def check_cpu_latency_request(latency_us: int) -> None:
+    """Make the request once and withdraw it: a launch that cannot make it stops before any
+    node starts, with the reason (``CliError``)."""
+    from haptic_msgs_py.cpu_latency import hold
+
+    try:
+        os.close(hold(latency_us))
+    except ValueError as exc:
+        raise CliError(f"--cpu-latency {latency_us}: {exc}") from None
 
 
 def write_params_file(params: dict[str, Any], directory: Path) -> Path:
@@ -382,6 +394,7 @@ def command(
         print(f"haptic-launch: CPUs {add_pinning(params)}", file=sys.stderr)
     if cpu_latency_us is not None:
         add_cpu_latency(params, cpu_latency_us)
+        check_cpu_latency_request(cpu_latency_us)
     net = network_env(network, peers)
     if rt_priority is not None:  # the nodes started below inherit the policy
         set_rt_priority(rt_priority)
@@ -472,9 +485,10 @@ def main(argv: list[str] | None = None) -> int:
         "--cpu-latency",
         type=int,
         metavar="US",
-        help="while the nodes run, CPUs wake from idle within US microseconds (their "
-        "cpu_latency_us; Linux PM QoS, needs root): 0 makes idle CPUs poll, which speeds up every "
-        "hand-over on a virtual machine (BENCHMARKS.md) and costs power",
+        help="while the nodes run, CPUs use only idle states whose advertised exit latency is at "
+        "most US microseconds (their cpu_latency_us; Linux PM QoS, needs root): 0 makes idle CPUs "
+        "poll, which speeds up every hand-over (BENCHMARKS.md) and costs power; on a virtual "
+        "machine only 0 helps",
     )
     a = p.parse_args(argv)
     only = [n for n in a.only.split(",") if n]

@@ -4,12 +4,13 @@ Between two messages of a cycle a node process sleeps, and so does its CPU when 
 there. Waking a CPU from a deep idle state takes time, and on a virtual machine much more: a
 halted virtual CPU waits for the host to schedule it again. A trace of the 4-process graph on
 the 2-core virtual machine of BENCHMARKS.md showed a hand-over of about 300 us to an idle CPU
-where about 120 us is usual. Writing a latency bound in microseconds to ``/dev/cpu_dma_latency``
-and keeping the file open asks the kernel to use only idle states that wake within that bound
-(0: the CPU polls instead of sleeping); closing it, or the process ending, withdraws the
-request. This is what ``cyclictest`` and real-time control stations do. It costs power (an idle
-CPU spins), so it is asked for, never the default, and it needs write access to the device (root,
-as a rule).
+where about 130 us is usual. Writing a latency bound in microseconds to ``/dev/cpu_dma_latency``
+and keeping the file open asks the kernel to use only idle states whose advertised exit latency
+is within that bound (0: the CPU polls instead of sleeping; a virtual machine's halt state
+advertises about 1 us, however long the host takes, so there only 0 helps); closing it, or the
+process ending, withdraws the request. This is what ``cyclictest`` and real-time control stations
+do. It costs power (an idle CPU spins), so it is asked for, never the default, and it needs write
+access to the device (root, as a rule).
 """
 
 from __future__ import annotations

@@ -32,10 +32,11 @@ def process_specs() -> list[ParamSpec]:
         ParamSpec(
             "cpu_latency_us",
             -1,
-            "while this process runs, CPUs wake from idle within this bound (Linux PM QoS "
-            "request on /dev/cpu_dma_latency, held open; needs write access to it, root as a "
-            "rule): 0 = idle CPUs poll and wake at once (costs power). -1 = no request. "
-            "haptic-launch --cpu-latency sets it on every loop node",
+            "while this process runs, CPUs use only idle states whose advertised exit latency "
+            "is at most this (Linux PM QoS request on /dev/cpu_dma_latency, held open; needs "
+            "write access to it, root as a rule; a node that cannot make it does not start): "
+            "0 = idle CPUs poll and wake at once (costs power; on a virtual machine only 0 "
+            "helps). -1 = no request. haptic-launch --cpu-latency sets it on every loop node",
             unit="us",
             min=-1,
             max=1_000_000,
