@@ -136,6 +136,7 @@ class Collector:
         self.topics = dict(topics)
         self.records: dict[str, list[tuple[float, bytes]]] = {t: [] for t in topics}
         self._lock = threading.Lock()
+        self._subs: dict[str, Any] = {}
         for topic, typename in topics.items():
 
             def cb(data: bytes, topic: str = topic) -> None:
@@ -143,7 +144,9 @@ class Collector:
                     self.records[topic].append((time.monotonic(), data))
 
             qos = RECORD if topic in SESSION_TOPICS else volatile
-            self.node.create_subscription(rclpy_type(typename), topic, cb, qos, raw=True)
+            self._subs[topic] = self.node.create_subscription(
+                rclpy_type(typename), topic, cb, qos, raw=True
+            )
         # the events executor (as the nodes use): a loaded machine must not leave this test's
         # own subscriber more than the publishers' 2000-sample history behind
         self.executor = EventsExecutor(context=self.context)
@@ -155,6 +158,11 @@ class Collector:
     def _spin(self) -> None:
         while not self._stop.is_set() and self.context.ok():
             self.executor.spin_once(timeout_sec=0.05)
+
+    def matched(self) -> bool:
+        """Whether every subscription has matched a publisher (a volatile one gets nothing sent
+        before)."""
+        return all(sub.get_publisher_count() >= 1 for sub in self._subs.values())
 
     def count(self, topic: str) -> int:
         with self._lock:
