@@ -275,3 +275,17 @@ def restart(
     params_file = write_params_file(params, log_dir)
     spec = next(s for s in plan(params, params_file, "") if s.name == name)
     procs[name] = Process([spec.executable, *spec.ros_args], env, log_dir / f"{name}.restarted.log")
+
+
+def switch(env: dict[str, str], mode: str, within: float = 30.0) -> tuple[bool, str]:
+    """Set the controller's mode; retried while refused because the input is not flowing yet.
+
+    In OL the observer is off the lockstep critical path: on a loaded machine it may lag more than
+    the controller's warm window, and the switch is then refused (as designed) until it catches up.
+    """
+    end = time.monotonic() + within
+    while True:
+        ok, reason = set_parameter(env, "controller_node", "mode", mode)
+        if ok or "not flowing" not in reason or time.monotonic() > end:
+            return ok, reason
+        time.sleep(0.5)

@@ -18,7 +18,7 @@ from haptic_msgs_py.topics import (
     WRENCH_ESTIMATE,
     WRENCH_MEASURED,
 )
-from rosgraph import Collector, isolated_env, launch, set_parameter
+from rosgraph import Collector, isolated_env, launch, set_parameter, switch
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -58,20 +58,6 @@ def laws(
         matches.append({n for n, v in candidates.items() if abs(np.clip(v, -4, 4) - u) < 1e-12})
         values.append((u, candidates))
     return stamps, matches, values
-
-
-def switch(env: dict[str, str], mode: str, within: float = 30.0) -> tuple[bool, str]:
-    """Set the controller's mode; retried while refused because the input is not flowing yet.
-
-    In OL the observer is off the lockstep critical path: on a loaded machine it may lag more than
-    the controller's warm window, and the switch is then refused (as designed) until it catches up.
-    """
-    end = time.monotonic() + within
-    while True:
-        ok, reason = set_parameter(env, "controller_node", "mode", mode)
-        if ok or "not flowing" not in reason or time.monotonic() > end:
-            return ok, reason
-        time.sleep(0.5)
 
 
 def test_switch_ol_dob_cl_takes_effect_on_the_next_cycle(root, tmp_path) -> None:
