@@ -65,6 +65,147 @@ def bench_observer_update(repeat: int) -> str:
     return f"median {statistics.median(runs):.2f} us per update (min {min(runs):.2f})"
 
 
+def batch_cycle_us(mode: str = "DOB", kf: float = 1.0, seconds: float = 10.0) -> float:
+    """One batch slide session's time per cycle (µs): the maths of the loop with no transport."""
+    from haptic_sim.session import SessionConfig, run_session
+    from haptic_sim.stability import law_for
+
+    cfg = SessionConfig().replace(law=law_for(mode, kf), loop__duration_s=seconds)
+    t0 = time.perf_counter()
+    run_session(cfg)
+    return (time.perf_counter() - t0) / (seconds * 1e3) * 1e6
+
+
+def _hop_peer(role: str, n: int, domain: str, out: Any) -> None:
+    """One side of the ping-pong: ``a`` sends and times, ``b`` echoes (raw bytes, events
+    executor, the loop's QoS: reliable transient-local publisher, best-effort subscription)."""
+    os.environ["ROS_DOMAIN_ID"] = domain
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.experimental import EventsExecutor
+    from std_msgs.msg import Header
+
+    from haptic_msgs_py import wire
+    from haptic_msgs_py.ros.qos import LOOP, LOOP_IN
+
+    ctx = Context()
+    rclpy.init(context=ctx, args=[])
+    node = rclpy.create_node(f"hop_{role}", context=ctx)
+    ex = EventsExecutor(context=ctx)
+    send, receive = ("ping", "pong") if role == "a" else ("pong", "ping")
+    pub = node.create_publisher(Header, send, LOOP)
+    state = {"got": 0}
+    rtts: list[float] = []
+    data = wire.encode(wire.header("base_link"))
+
+    def on_data(msg: bytes) -> None:
+        if role == "b":
+            pub.publish(msg)
+        else:
+            rtts.append(time.perf_counter() - state["t"])
+            state["got"] += 1
+
+    node.create_subscription(Header, receive, on_data, LOOP_IN, raw=True)
+    ex.add_node(node)
+    end = time.monotonic() + 30.0
+    while pub.get_subscription_count() < 1 and time.monotonic() < end:
+        ex.spin_once(timeout_sec=0.01)
+    if role == "b":
+        end = time.monotonic() + 60.0 + n * 0.01
+        while time.monotonic() < end and ctx.ok():
+            ex.spin_once(timeout_sec=0.05)
+        return
+    time.sleep(0.5)  # the echo's publisher matched too
+    for _ in range(n):
+        state["t"] = time.perf_counter()
+        before = state["got"]
+        pub.publish(data)
+        limit = time.monotonic() + 1.0
+        while state["got"] == before and time.monotonic() < limit:
+            ex.spin_once(timeout_sec=0.1)
+    out.put(rtts)
+
+
+def hop_us(n: int = 3000) -> float:
+    """Median one-way latency (µs) of a small raw message between two rclpy processes: half the
+    round trip of a ping-pong, the first 10 % left out (warm-up)."""
+    import multiprocessing
+    import random
+
+    ctx = multiprocessing.get_context("spawn")
+    out = ctx.Queue()
+    domain = str(random.randint(101, 200))
+    echo = ctx.Process(target=_hop_peer, args=("b", n, domain, out))
+    echo.start()
+    timer = ctx.Process(target=_hop_peer, args=("a", n, domain, out))
+    timer.start()
+    try:
+        rtts = out.get(timeout=120.0 + n * 0.01)
+    finally:
+        timer.join(10)
+        echo.terminate()
+        echo.join(10)
+    kept = rtts[len(rtts) // 10 :]
+    if not kept:
+        raise RuntimeError("the ping-pong got no answer")
+    return statistics.median(kept) / 2 * 1e6
+
+
+def bench_hop(repeat: int) -> str:
+    """The DDS floor of one hop between two processes (ping-pong, events executor)."""
+    hops = [hop_us() for _ in range(repeat)]
+    return (
+        f"one hop median {statistics.median(hops):.0f} us (runs: "
+        f"{', '.join(f'{h:.0f}' for h in hops)})"
+    )
+
+
+def _lockstep_cycle_us(extra: list[str], seconds: float = 20.0) -> float:
+    """One lockstep graph run's time per cycle (µs), from the device's real-time factor."""
+    import re
+
+    text = _launch(graph_args(extra), [f"device_node:duration_s={seconds}"], 300)
+    found = re.search(r"real-time factor ([0-9.]+)", text)
+    if found is None:
+        raise RuntimeError(f"no real-time factor in the launch output: {text[-1500:]}")
+    return 1e3 / float(found.group(1))
+
+
+MARGIN_MODE = ["--set", "controller_node:mode=DOB", "--set", "controller_node:kf=1.0"]
+
+
+def bench_margin(repeat: int) -> str:
+    """The loop's cost against its floors, in DOB mode, each ratio taken within one run:
+
+    - composed lockstep cycle / batch cycle (batch measured just before and after the graph);
+    - 4-process lockstep cycle / (3 raw hops + batch cycle), hops measured before and after.
+    """
+    composed, processes = [], []
+    rows = []
+    for _ in range(repeat):
+        b1 = batch_cycle_us()
+        c = _lockstep_cycle_us(["--composed", *MARGIN_MODE])
+        b2 = batch_cycle_us()
+        h1 = hop_us()
+        p = _lockstep_cycle_us(["--processes", *MARGIN_MODE])
+        h2 = hop_us()
+        b3 = batch_cycle_us()
+        composed.append(c / ((b1 + b2) / 2))
+        floor = 3 * (h1 + h2) / 2 + (b2 + b3) / 2
+        processes.append(p / floor)
+        rows.append(
+            f"batch {b1:.0f}/{b2:.0f}/{b3:.0f} us, composed {c:.0f} us, hop {h1:.0f}/{h2:.0f} "
+            f"us, 4 processes {p:.0f} us (floor {floor:.0f})"
+        )
+    return (
+        f"composed / batch cycle: median {statistics.median(composed):.2f} (runs: "
+        f"{', '.join(f'{r:.2f}' for r in composed)}); 4 processes / (3 hops + batch): median "
+        f"{statistics.median(processes):.2f} (runs: {', '.join(f'{r:.2f}' for r in processes)})"
+        f"; {'; '.join(rows)}"
+    )
+
+
 def _launch(extra: list[str], sets: list[str], timeout: float) -> str:
     """Run ``haptic-launch slide_sim`` on a fresh domain; return its combined output."""
     import random
@@ -261,6 +402,8 @@ BENCHMARKS: dict[str, Callable[[int], str]] = {
     "realtime": bench_realtime,
     "realtime-composed": bench_realtime_composed,
     "timer-floor": bench_timer_floor,
+    "hop": bench_hop,
+    "margin": bench_margin,
 }
 
 

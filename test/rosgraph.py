@@ -244,20 +244,35 @@ def set_parameter(env: dict[str, str], node: str, name: str, value: Any, timeout
 
 
 def start_nodes(
-    config: Path, env: dict[str, str], sets: Iterable[str], log_dir: Path, namespace: str = ""
+    config: Path,
+    env: dict[str, str],
+    sets: Iterable[str],
+    log_dir: Path,
+    namespace: str = "",
+    groups: Iterable[Iterable[str]] = (),
 ) -> dict[str, Process]:
-    """Each node of ``config`` as its own process via ``<prefix>/lib/<pkg>/<exe>`` (no launcher,
-    so a test can kill and restart single nodes)."""
+    """The nodes of ``config`` as processes via the ros2 run contract (no launcher, so a test
+    can kill and restart one): each node alone, except ``groups`` (nodes sharing a process).
+
+    Keyed by every node's name (the nodes of a group share one ``Process``).
+    """
     from haptic_dob.launcher import parse_sets, plan, resolved_params, write_params_file
 
     params = resolved_params(config, parse_sets(list(sets)))
     params_file = write_params_file(params, log_dir)
     procs = {}
-    for spec in plan(params, params_file, namespace):
-        procs[spec.name] = Process(
-            [spec.executable, *spec.ros_args], env, log_dir / f"{spec.name}.log"
-        )
+    for spec in plan(params, params_file, namespace, [list(g) for g in groups]):
+        log = log_dir / f"{spec.name.replace(', ', '+')}.log"
+        proc = Process([spec.executable, *spec.args], env, log)
+        for node in spec.nodes:
+            procs[node] = proc
     return procs
+
+
+def stop_all(procs: dict[str, Process]) -> None:
+    """Stop every process of ``start_nodes`` once (a group's appears under each of its nodes)."""
+    for proc in {id(p): p for p in procs.values()}.values():
+        proc.stop()
 
 
 def restart(
@@ -274,7 +289,7 @@ def restart(
     params = resolved_params(config, parse_sets(list(sets)))
     params_file = write_params_file(params, log_dir)
     spec = next(s for s in plan(params, params_file, "") if s.name == name)
-    procs[name] = Process([spec.executable, *spec.ros_args], env, log_dir / f"{name}.restarted.log")
+    procs[name] = Process([spec.executable, *spec.args], env, log_dir / f"{name}.restarted.log")
 
 
 def switch(env: dict[str, str], mode: str, within: float = 30.0) -> tuple[bool, str]:

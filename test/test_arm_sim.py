@@ -224,7 +224,7 @@ def test_device_node_builds_and_steps_the_phantom(monkeypatch: pytest.MonkeyPatc
         try:
             assert isinstance(node.device, SimulatedArm) and node.dof == 3
             assert node.limits == node.device.max_effort
-            node._step([0.1, 0.2, 0.3])
+            node._advance([0.1, 0.2, 0.3])
             assert node.device.k == 1 and node.device.sample().effort == (0.1, 0.2, 0.3)
             assert isinstance(obs.model, PhantomModel) and obs.model.joint_names == (
                 "phi1",

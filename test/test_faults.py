@@ -1,9 +1,10 @@
 """Faults in real time: a node killed with SIGKILL stops the force at once; a restart resumes.
 
-The graph runs with each node in its own process (started through the ros2 run contract, not the
-launcher, so one can be killed). The test measures, on the device's own sample clock, how long
-after the last command the applied effort (``joint_states.effort``) reaches zero, reads why from
-``/diagnostics``, restarts the node and sees the force come back.
+The node to kill runs in its own process, the rest of the loop composed in another (started
+through the ros2 run contract, not the launcher, so one can be killed): a loop of two processes.
+The test measures, on the device's own sample clock, how long after the last command the applied
+effort (``joint_states.effort``) reaches zero, reads why from ``/diagnostics``, restarts the node
+and sees the force come back.
 """
 
 from __future__ import annotations
@@ -17,11 +18,12 @@ import time
 import numpy as np
 import pytest
 
+from capacity import require_realtime
 from conftest import tool
 from haptic_msgs_py.stamps import command_stamp, stamp_ns
 from haptic_msgs_py.topics import DIAGNOSTICS, EFFORT_COMMAND, JOINT_STATES, SESSION_TOPICS
 from recorded import assert_received_written_in_bag, bag_stamps
-from rosgraph import Collector, Process, isolated_env, restart, start_nodes
+from rosgraph import Collector, Process, isolated_env, restart, start_nodes, stop_all
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -29,6 +31,14 @@ pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 # command; the zero effort shows in the sample after that tick: at most the timeout + 2 periods
 TIMEOUT_S = 0.005
 PERIOD_S = 0.001
+
+
+LOOP = ("environment_node", "observer_node", "controller_node", "device_node")
+
+
+def others(victim: str) -> list[str]:
+    """The loop's nodes but ``victim``: they share a process, the victim has its own."""
+    return [n for n in LOOP if n != victim]
 
 
 def efforts(col: Collector) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -83,6 +93,7 @@ def diagnostics_after(col: Collector, t0: float) -> list[str]:
 def test_kill_9_zeroes_the_force_within_the_command_timeout(
     root, tmp_path, victim, mode, reason
 ) -> None:
+    require_realtime([others(victim)], mode)
     env = isolated_env()
     config = root / "config" / "slide_sim.yaml"
     sets = [
@@ -90,6 +101,9 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         "device_node:duration_s=0.0",
         f"controller_node:mode={mode}",
         "controller_node:kf=1.0",
+        # a fine encoder: consecutive commands differ, so the run of equal efforts before the
+        # zero starts at the first sample that shows the last command the device received
+        "device_node:plant.encoder_resolution_m=1.0e-9",
     ]
     col = Collector(
         env,
@@ -99,7 +113,7 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
             EFFORT_COMMAND: SESSION_TOPICS[EFFORT_COMMAND],
         },
     )
-    procs = start_nodes(config, env, sets, tmp_path)
+    procs = start_nodes(config, env, sets, tmp_path, groups=[others(victim)])
     try:
         # the loop runs: the hand pushes into the wall, the effort is the wall's push-back
         deadline = time.monotonic() + 40
@@ -172,8 +186,7 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         assert wait_for_effort(col, t_restart, 400, 20), f"the loop did not stay closed: {victim}"
         assert after.any()
     finally:
-        for p in procs.values():
-            p.stop()
+        stop_all(procs)
         col.close()
 
 
@@ -191,13 +204,14 @@ def wait_for_effort(col: Collector, since: float, n: int, timeout: float) -> boo
 def test_a_bag_recorded_across_a_node_kill_is_readable_and_analysable(root, tmp_path) -> None:
     """haptic-record runs through kill -9 and restart of the environment node in real time: it
     stops cleanly, wrote what it received, the gap is in the bag, and haptic-analyze reads it."""
+    require_realtime([others("environment_node")])
     env = isolated_env()
     config = root / "config" / "slide_sim.yaml"
     sets = ["device_node:clock_mode=realtime", "device_node:duration_s=0.0"]
     bag = tmp_path / "across_kill"
     col = Collector(env, {JOINT_STATES: SESSION_TOPICS[JOINT_STATES]})
     rec = Process([tool("haptic-record"), str(bag)], env, tmp_path / "record.log")
-    procs = start_nodes(config, env, sets, tmp_path)
+    procs = start_nodes(config, env, sets, tmp_path, groups=[others("environment_node")])
     try:
         assert wait_for_effort(col, 0.0, 4000, 60), procs["device_node"].output()[-2000:]
         os.kill(procs["environment_node"].proc.pid, signal.SIGKILL)
@@ -210,8 +224,7 @@ def test_a_bag_recorded_across_a_node_kill_is_readable_and_analysable(root, tmp_
         assert rec.wait(30) == 0, rec.output()
     finally:
         rec.stop()
-        for p in procs.values():
-            p.stop()
+        stop_all(procs)
         col.close()
     assert_received_written_in_bag(bag)
     stamps = bag_stamps(bag)

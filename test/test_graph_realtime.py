@@ -6,6 +6,7 @@ import json
 
 import pytest
 
+from capacity import require_realtime
 from rosgraph import isolated_env, launch
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
@@ -19,8 +20,15 @@ def test_realtime_loop_closes_at_rate(root, tmp_path, composed: bool) -> None:
     first cycles rather than whenever the other processes happen to finish starting. The share of
     commands arriving before the next tick is a benchmark (BENCHMARKS.md); the test only asserts
     that the loop closes early (commands for at least 2700 of 3000 ticks, most of them on time)
-    and that nothing is refused.
+    and that nothing is refused. Skips where the suite's capacity measurement says this machine
+    cannot turn this loop over fast enough for real time at 1 kHz now.
     """
+    loop = ["environment_node", "observer_node", "controller_node", "device_node"]
+    # four processes: every message between them costs a process wake-up on each side (about
+    # 0.2 ms of CPU on a slow virtual machine); this run never switches modes, so the controller
+    # takes only the wall force (no warm inputs)
+    light = [] if composed else ["controller_node:warm_inputs=false"]
+    require_realtime([loop] if composed else [], sets=light)
     env = isolated_env()
     stats = tmp_path / "stats.json"
     graph = launch(
@@ -30,9 +38,10 @@ def test_realtime_loop_closes_at_rate(root, tmp_path, composed: bool) -> None:
             "device_node:clock_mode=realtime",
             "device_node:duration_s=3.0",
             f"device_node:stats_file={stats}",
+            *light,
         ],
         tmp_path / "launch.log",
-        extra=["--composed"] if composed else [],
+        extra=[] if composed else ["--processes"],
     )
     try:
         assert graph.wait(60) == 0, graph.output()

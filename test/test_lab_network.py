@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from capacity import require_realtime
 from rosgraph import Process, isolated_env
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
@@ -81,6 +82,7 @@ def wait_live(csv: Path, since: float, timeout: float) -> bool:
 
 
 def test_loop_across_two_hosts_and_a_link_failure(hosts, root, tmp_path) -> None:
+    require_realtime([["environment_node", "observer_node", "controller_node"]])
     ns_a, ns_b, dev_a = hosts
     env = isolated_env()
     env.pop("ROS_AUTOMATIC_DISCOVERY_RANGE")
@@ -120,7 +122,9 @@ def test_loop_across_two_hosts_and_a_link_failure(hosts, root, tmp_path) -> None
                 "device_node:clock_mode=realtime",
                 "--set",
                 "device_node:duration_s=0.0",
-            ],
+                "--set",  # a fine encoder: every command differs from the one before it, so the
+                "device_node:plant.encoder_resolution_m=1.0e-9",  # run of equal efforts below
+            ],  # starts exactly at the last command the device received
             env,
             tmp_path / "a.log",
         ),

@@ -50,16 +50,20 @@ def _stub_modules(monkeypatch, launch_args: dict[str, str]) -> None:
         monkeypatch.setitem(sys.modules, name, mod)
 
 
-def test_launch_file_is_installed_and_plans_the_session(monkeypatch) -> None:
+def _plan(monkeypatch, **launch_args: str) -> list:
     path = Path(get_package_share_directory("haptic_dob")) / "launch" / "session.launch.py"
     assert path.is_file()
-    _stub_modules(monkeypatch, {"config": "slide_sim", "namespace": "slide1"})
+    _stub_modules(monkeypatch, {"config": "slide_sim", "namespace": "slide1", **launch_args})
     spec = importlib.util.spec_from_file_location("session_launch", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     ld = module.generate_launch_description()
     opaque = ld.args[0][-1]
-    nodes = opaque.kwargs["function"](context=None)
+    return opaque.kwargs["function"](context=None)
+
+
+def test_launch_file_is_installed_and_plans_the_session(monkeypatch) -> None:
+    nodes = _plan(monkeypatch, composed="false")
     planned = [(n.kwargs["package"], n.kwargs["executable"], n.kwargs["namespace"]) for n in nodes]
     assert planned == [
         ("haptic_dob", "environment_node", "slide1"),
@@ -73,3 +77,24 @@ def test_launch_file_is_installed_and_plans_the_session(monkeypatch) -> None:
     for pkg, exe, _ in planned:
         shim = Path(get_package_share_directory(pkg)).parents[1] / "lib" / pkg / exe
         assert shim.is_file(), shim
+
+
+def test_launch_file_composes_the_loop_by_default(monkeypatch) -> None:
+    """As haptic-launch: the loop's nodes in the container, with a params file by node name."""
+    import yaml
+
+    (node,) = _plan(monkeypatch, composed="true")
+    assert (node.kwargs["package"], node.kwargs["executable"]) == ("haptic_dob", "container")
+    assert node.kwargs["arguments"] == [
+        "environment_node",
+        "observer_node",
+        "controller_node",
+        "device_node",
+    ]
+    assert node.kwargs["namespace"] == "slide1" and "name" not in node.kwargs
+    (params_file,) = node.kwargs["parameters"]
+    doc = yaml.safe_load(Path(params_file).read_text())
+    assert doc["/**/device_node"]["ros__parameters"]["clock_mode"] == "lockstep"
+    assert doc["/**/environment_node"]["ros__parameters"]["stiffness_n_per_m"] == 800.0
+    shim = Path(get_package_share_directory("haptic_dob")).parents[1] / "lib" / "haptic_dob"
+    assert (shim / "container").is_file()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -47,8 +48,16 @@ def alive(pid: int) -> bool:
 
 
 @pytest.mark.multiprocess
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
-def test_signal_to_the_launcher_stops_every_node_cleanly(root, tmp_path, sig) -> None:
+@pytest.mark.parametrize(
+    ("sig", "extra", "processes"),
+    [(signal.SIGINT, [], 1), (signal.SIGTERM, ["--processes"], 4)],
+    ids=["SIGINT-composed", "SIGTERM-processes"],
+)
+def test_signal_to_the_launcher_stops_every_node_cleanly(
+    root, tmp_path, sig, extra: list[str], processes: int
+) -> None:
+    """The loop composed in one process (the default) or each node in its own: a signal to the
+    launcher stops every one cleanly."""
     env = isolated_env()
     log = tmp_path / "launch.log"
     out = open(log, "w")  # noqa: SIM115 - closed in finally, the launcher writes to it
@@ -56,6 +65,7 @@ def test_signal_to_the_launcher_stops_every_node_cleanly(root, tmp_path, sig) ->
         [
             tool("haptic-launch"),
             str(root / "config" / "slide_sim.yaml"),
+            *extra,
             "--set",
             "device_node:clock_mode=realtime",
             "--set",
@@ -68,10 +78,10 @@ def test_signal_to_the_launcher_stops_every_node_cleanly(root, tmp_path, sig) ->
     try:
         deadline = time.monotonic() + 30
         kids: list[int] = []
-        while time.monotonic() < deadline and len(kids) < 4:
+        while time.monotonic() < deadline and len(kids) < processes:
             kids = children_of(proc.pid)
             time.sleep(0.2)
-        assert len(kids) == 4, log.read_text()
+        assert len(kids) == processes, log.read_text()
         time.sleep(2.0)  # let the loop run
         proc.send_signal(sig)
         assert proc.wait(30) == 0, log.read_text()
@@ -80,10 +90,12 @@ def test_signal_to_the_launcher_stops_every_node_cleanly(root, tmp_path, sig) ->
         text = log.read_text()
         assert "Traceback" not in text and "did not stop" not in text, text
     finally:
+        leftover = children_of(proc.pid) if proc.poll() is None else []  # before they are orphans
         if proc.poll() is None:
             proc.kill()
-        for pid in children_of(proc.pid):
-            os.kill(pid, signal.SIGKILL)
+        for pid in leftover + [p for p in kids if alive(p)]:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
         out.close()
 
 
@@ -136,7 +148,14 @@ def launch_cli(*args: str, env=None) -> subprocess.CompletedProcess:
         (["slide_sim", "--set", "pilot_node:kf=1"], "ERROR: --set names unknown node 'pilot_node'"),
         (["slide_sim", "--set", "controller_node:kf=[1"], "the value is not valid YAML"),
         (["slide_sim", "--rt-priority", "0"], "ERROR: --rt-priority 0: must be 1 to 99"),
-        (["slide_sim", "--pin", "--composed"], "ERROR: --pin places the nodes' processes"),
+        (["slide_sim", "--pin"], "ERROR: --pin places node processes on CPUs"),
+        (["slide_sim", "--pin", "--composed"], "ERROR: --pin places node processes on CPUs"),
+        (["slide_sim", "--processes", "--composed"], "ERROR: --composed, --processes and --group"),
+        (["slide_sim", "--group", "device_node,pilot_node"], "--group names unknown node(s)"),
+        (
+            ["slide_sim", "--group", "device_node,controller_node", "--group", "device_node"],
+            "ERROR: --group: device_node named in more than one place",
+        ),
     ],
 )
 def test_bad_input_gets_one_error_line(args, message) -> None:
@@ -163,7 +182,8 @@ def test_a_refused_node_parameter_stops_the_graph_with_its_reason(root, tmp_path
     out = launch_cli(str(root / "config" / "slide_sim.yaml"), "--set", "controller_node:kf=-3")
     assert out.returncode == 1
     assert "parameter kf refused" in out.stderr
-    assert "controller_node exited with code 2" in out.stderr
+    line = next(x for x in out.stderr.splitlines() if "exited with code 2" in x)
+    assert line.startswith("ERROR: the process of ") and "controller_node" in line, out.stderr
 
 
 @pytest.mark.multiprocess
@@ -253,7 +273,7 @@ def test_pin_runs_each_node_process_on_its_planned_cpu(root, tmp_path) -> None:
         isolated_env(),
         ["device_node:clock_mode=realtime", "device_node:duration_s=0.0"],
         log,
-        ["--pin"],
+        ["--pin", "--processes"],
     )
     try:
         deadline = time.monotonic() + 60
@@ -305,7 +325,7 @@ def test_cpu_latency_is_held_while_the_graph_runs_and_withdrawn_after(tmp_path) 
         isolated_env(),
         ["device_node:clock_mode=realtime", "device_node:duration_s=0.0"],
         log,
-        ["--cpu-latency", "0"],
+        ["--cpu-latency", "0", "--processes"],
     )
     try:
         deadline = time.monotonic() + 60
@@ -371,3 +391,49 @@ def test_pin_refuses_a_cpu_affinity_that_is_no_list(given) -> None:
 
     with pytest.raises(CliError, match="cpu_affinity of device_node must be a list of CPU"):
         add_pinning({"device_node": {"cpu_affinity": given}})
+
+
+def test_the_loop_shares_a_process_by_default_and_a_recorder_runs_apart(root, tmp_path) -> None:
+    from haptic_dob.launcher import add_recorder, groups_for, plan, resolved_params
+
+    params = resolved_params(root / "config" / "slide_sim.yaml", {})
+    add_recorder(params, str(tmp_path / "bag"), "mcap")
+    names = [n for n in params if n != "/**"]
+    loop = ["environment_node", "observer_node", "controller_node", "device_node"]
+    specs = plan(params, tmp_path / "p.yaml", "/ns", groups_for(names, False, False, ()))
+    assert [s.nodes for s in specs] == [["recorder_node"], loop]
+    station = specs[1]
+    assert Path(station.executable).parts[-3:] == ("lib", "haptic_dob", "container")
+    assert station.args[:4] == loop and "__ns:=/ns" in station.args
+    assert not any(a.startswith("__node:=") for a in station.args)  # the nodes keep their names
+    assert station.label == "the process of " + ", ".join(loop)
+    alone = plan(params, tmp_path / "p.yaml", "", groups_for(names, False, True, ()))
+    assert [s.nodes for s in alone] == [[n] for n in ["recorder_node", *loop]]
+    assert all(f"__node:={s.name}" in s.args for s in alone)
+    pairs = groups_for(names, False, False, ["device_node,controller_node"])
+    assert [s.nodes for s in plan(params, tmp_path / "p.yaml", "", pairs)] == [
+        ["recorder_node"],
+        ["environment_node"],
+        ["observer_node"],
+        ["controller_node", "device_node"],
+    ]
+    everything = plan(params, tmp_path / "p.yaml", "", groups_for(names, True, False, ()))
+    assert [s.nodes for s in everything] == [["recorder_node", *loop]]
+
+
+@pytest.mark.parametrize(
+    ("args", "code", "message"),
+    [
+        ([], 2, "ERROR: name at least one node to run"),
+        (["device_node", "pilot_node"], 2, "ERROR: unknown node(s) pilot_node; nodes:"),
+        (["device_node", "device_node"], 2, "ERROR: a node is named twice"),
+        (["device_node", "--ros-args", "-r", "__node:=x"], 2, "__node:= would give every node"),
+        (["--help"], 0, "usage: container NODE [NODE ...]"),
+    ],
+)
+def test_the_container_answers_bad_arguments_with_one_line(args, code: int, message: str) -> None:
+    out = subprocess.run(
+        [tool("haptic-container"), *args], capture_output=True, text=True, timeout=60
+    )
+    assert out.returncode == code, out.stderr
+    assert message in out.stdout + out.stderr and "Traceback" not in out.stderr

@@ -10,6 +10,7 @@ from rclpy.parameter import Parameter
 from haptic_dob.nodes.controller_node import ControllerNode
 from haptic_dob.nodes.environment_node import EnvironmentNode
 from haptic_dob.nodes.observer_node import ObserverNode
+from haptic_msgs_py.values import EffortCommand, StampedVector
 from haptic_sim.nodes.device_node import DeviceNode
 from rosgraph import isolated_env
 
@@ -100,8 +101,8 @@ def test_switch_to_dob_is_refused_until_the_observer_is_warm(context) -> None:
         assert ctl.controller.law.mode.value == "OL"
         period = ctl.period_ns
         for k in range(30):  # estimates and wall forces of 30 consecutive cycles
-            ctl.estimated.take(k * period, (0.0, 0.0, 0.0))
-            ctl._note(k * period)
+            ctl._on_estimated(StampedVector(k * period, (0.0, 0.0, 0.0)))
+            ctl._on_desired(StampedVector(k * period, (0.0, 0.0, 0.0)))
         assert ctl.set_parameters([Parameter("mode", value="DOB")])[0].successful
         assert ctl.controller.law.mode.value == "DOB"
         res = ctl.set_parameters([Parameter("mode", value="CL")])[0]
@@ -150,21 +151,20 @@ def test_bad_start_values_fail_the_node_with_the_reason() -> None:
 def test_device_holds_the_loop_while_a_recorder_lags(context) -> None:
     """Lockstep back-pressure: a command is held until the recorder's progress catches up."""
     from haptic_msgs_py import wire
-    from haptic_msgs_py.stamps import command_label
 
     dev = DeviceNode(context=context)
     try:
         dev._started = True
         period = dev.period_ns
         for k in range(600):  # 0.6 s of simulated time, no recorder yet: the loop runs freely
-            dev._on_command(wire.float64_multi_array(command_label(k * period), [0.0]))
+            dev._on_command(EffortCommand(k * period, (0.0,)))
         assert dev.device.k == 600
         fast, slow = wire.header("/fast_recorder"), wire.header("/slow_recorder")
         fast.stamp = wire.Time(sec=0, nanosec=590_000_000)
         slow.stamp = wire.Time(sec=0, nanosec=50_000_000)  # has written 0.05 s
         dev._on_progress(fast)
         dev._on_progress(slow)
-        dev._on_command(wire.float64_multi_array(command_label(600 * period), [0.0]))
+        dev._on_command(EffortCommand(600 * period, (0.0,)))
         assert dev.device.k == 600 and dev._held is not None  # the slowest is 0.55 s behind: held
         slow.stamp = wire.Time(sec=0, nanosec=400_000_000)
         dev._on_progress(slow)  # caught up to 0.2 s behind: released
@@ -179,23 +179,14 @@ def test_after_a_switch_the_controller_waits_for_a_lagging_input(context) -> Non
     """In OL the observer is off the lockstep critical path and may lag; after the switch to DOB
     the controller waits for estimate k (no fallback, no zero command); once caught up, a silent
     input still trips the fallback after ``input_timeout_s``."""
-    from haptic_msgs_py import wire
-    from haptic_msgs_py.convert import write_force
-    from haptic_msgs_py.stamps import command_stamp
-
     ctl = ControllerNode(context=context)
     assert ctl.set_parameters([Parameter("kf", value=1.0)])[0].successful
     sent: dict[int, float] = {}
-    ctl._pub.publish = lambda m: sent.__setitem__(
-        command_stamp(m.layout.dim[0].label), float(m.data[0])
-    )
+    ctl._pub.publish = lambda m: sent.__setitem__(m.stamp_ns, m.effort[0])
     period = ctl.period_ns
 
-    def wrench(k: int, fx: float):
-        msg = wire.wrench_stamped("base_link")
-        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(k * period, 10**9)
-        write_force(msg, (fx, 0.0, 0.0))
-        return msg
+    def wrench(k: int, fx: float) -> StampedVector:
+        return StampedVector(k * period, (fx, 0.0, 0.0))
 
     try:
         for k in range(100):  # OL; the observer 50 cycles behind
@@ -204,14 +195,14 @@ def test_after_a_switch_the_controller_waits_for_a_lagging_input(context) -> Non
                 ctl._on_estimated(wrench(k - 50, 0.5))
         assert ctl.set_parameters([Parameter("mode", value="DOB")])[0].successful
         ctl._on_desired(wrench(100, -1.0))
-        assert 100 * period not in sent and ctl.fallback_reason is None  # waiting
+        assert 100 * period not in sent and ctl.join.fallback_reason is None  # waiting
         for k in range(50, 101):
             ctl._on_estimated(wrench(k, 0.5))
         assert sent[100 * period] == -1.0 + 1.0 * (-1.0 + 0.5)  # the DOB law, stamp-100 inputs
-        assert ctl.fallbacks == 0
+        assert ctl.join.fallbacks == 0
         for k in range(101, 130):  # caught up; now the estimate stops
             ctl._on_desired(wrench(k, -1.0))
-        assert ctl.fallback_reason and "wrench_estimate" in ctl.fallback_reason
+        assert ctl.join.fallback_reason and "wrench_estimate" in ctl.join.fallback_reason
     finally:
         ctl.destroy_node()
 

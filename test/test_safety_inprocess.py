@@ -20,8 +20,7 @@ from rclpy.parameter import Parameter
 from haptic_dob.nodes.controller_node import ControllerNode
 from haptic_dob.nodes.environment_node import EnvironmentNode
 from haptic_dob.nodes.observer_node import ObserverNode
-from haptic_msgs_py import wire
-from haptic_msgs_py.stamps import command_label
+from haptic_msgs_py.values import EffortCommand
 from haptic_sim.nodes.device_node import DeviceNode
 from rosgraph import isolated_env
 
@@ -66,7 +65,7 @@ def test_no_bad_command_reaches_the_plant(context, stream) -> None:
         dev._tick(now)  # start: sample 0
         for cmd in stream:
             k = dev.device.k
-            dev._on_command(wire.float64_multi_array(command_label(k * dev.period_ns), cmd))
+            dev._on_command(EffortCommand(k * dev.period_ns, tuple(cmd)))
             now += 0.001
             dev._tick(now)
             applied = dev.device.sample().effort[0]
@@ -79,27 +78,46 @@ def test_no_bad_command_reaches_the_plant(context, stream) -> None:
 
 
 def test_watchdog_zeroes_the_effort_and_the_next_command_resumes(context) -> None:
+    """Command 0, then silence: the command is held for ``command_timeout_s`` of samples, then
+    the effort is zero and the report says why; the next valid command resumes."""
     dev = DeviceNode(context=context)
     try:
-        timeout = dev.params.values["command_timeout_s"]
-        dev._tick(10.0)
-        dev._on_command(wire.float64_multi_array(command_label(0), [1.5]))
-        dev._last_command_s = 10.0
-        dev._tick(10.001)
-        assert dev.device.sample().effort == (1.5,)
-        dev._tick(10.0 + timeout * 0.9)
-        assert dev.device.sample().effort == (1.5,) and not dev.watchdog_tripped
-        dev._tick(10.0 + timeout * 1.1)  # silence beyond the timeout
+        limit = round(dev.params.values["command_timeout_s"] * 1e9 / dev.period_ns)  # samples
+        t = 10.0
+        dev._tick(t)
+        dev._on_command(EffortCommand(0, (1.5,)))
+        for _ in range(limit + 1):  # held over [1, limit + 1): the timeout after the command
+            t += 0.001
+            dev._tick(t)
+            assert dev.device.sample().effort == (1.5,) and not dev.watchdog_tripped
+        t += 0.001
+        dev._tick(t)
         assert dev.device.sample().effort == (0.0,) and dev.watchdog_tripped
         _level, message, values = dev._report()
         assert "watchdog tripped" in message and values["watchdog"].startswith("tripped")
-        dev._on_command(
-            wire.float64_multi_array(command_label(dev.device.k * dev.period_ns), [-1.0])
-        )
-        import time
-
-        dev._tick(time.monotonic())
+        dev._on_command(EffortCommand(dev.device.k * dev.period_ns, (-1.0,)))
+        dev._tick(t + 0.001)
         assert dev.device.sample().effort == (-1.0,) and not dev.watchdog_tripped
+    finally:
+        dev.destroy_node()
+
+
+@pytest.mark.parametrize("gap_s", [0.0, 0.05], ids=["bunched", "stalled"])
+def test_watchdog_counts_the_plant_s_samples_not_the_wall_clock(context, gap_s: float) -> None:
+    """The simulated plant moves one sample per tick: ticks bunched in no wall time still trip
+    the watchdog after ``command_timeout_s`` of samples, and a stall of the device's own process
+    between two ticks (50 ms here, ten timeouts) does not."""
+    dev = DeviceNode(context=context)
+    try:
+        limit = round(dev.params.values["command_timeout_s"] * 1e9 / dev.period_ns)  # samples
+        dev._tick(10.0)
+        dev._on_command(EffortCommand(0, (1.5,)))
+        t = 10.0 + gap_s
+        for _ in range(limit + 1):
+            dev._tick(t)
+            assert dev.device.sample().effort == (1.5,) and not dev.watchdog_tripped
+        dev._tick(t)
+        assert dev.device.sample().effort == (0.0,) and dev.watchdog_tripped
     finally:
         dev.destroy_node()
 

@@ -1,14 +1,17 @@
 """``haptic-launch``: bring up a session's node graph from one ``ros__parameters`` YAML.
 
 Every node section of the YAML (``device_node``, ``environment_node``, ``observer_node``,
-``controller_node``, ``recorder_node``) starts as its own process through the ``ros2 run``
-contract (``<prefix>/lib/<pkg>/<exe>`` found with ``ament_index_python``), with
-``--ros-args --params-file CONFIG`` and the namespace. The device starts last. Ctrl-C or SIGTERM
-is forwarded to every node as SIGTERM (each shuts down cleanly: the device zeroes its effort; a
-node still starting up ends quietly, with no Python traceback as SIGINT would give) and
-the launcher waits for them, killing what is still alive after ``--stop-timeout``. When the
-device finishes a lockstep run (``duration_s``) the others are stopped too. ``--composed`` runs
-all nodes in this one process under one executor instead.
+``controller_node``, ``recorder_node``) starts through the ``ros2 run`` contract
+(``<prefix>/lib/<pkg>/<exe>`` found with ``ament_index_python``), with
+``--ros-args --params-file CONFIG`` and the namespace. Composition groups say which nodes share a
+process (``<prefix>/lib/haptic_dob/container``, where the loop's messages are handed over in
+process): by default the loop (device, environment, observer, controller) shares one and a
+recorder runs apart; ``--processes`` gives every node its own, ``--composed`` puts all in one,
+``--group`` names groups. The device's process starts last. Ctrl-C or SIGTERM is forwarded to
+every process as SIGTERM (each shuts down cleanly: the device zeroes its effort; a node still
+starting up ends quietly, with no Python traceback as SIGINT would give) and the launcher waits
+for them, killing what is still alive after ``--stop-timeout``. When the device finishes a
+lockstep run (``duration_s``) the others are stopped too.
 
 Network: by default every node's discovery stays on this host
 (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), so a simulated session never reaches a lab network
@@ -34,40 +37,28 @@ import yaml
 
 from haptic_dob.cli import ArgumentParser, CliError, run
 from haptic_dob.configs import resolve_config
+from haptic_dob.nodes.registry import CONTAINER, LOOP_NODES, NODES, START_ORDER
 from haptic_msgs_py.params import load_node_params
 
-#: node name -> (package, executable, import path of the node class for --composed)
-NODES: dict[str, tuple[str, str, str]] = {
-    "environment_node": (
-        "haptic_dob",
-        "environment_node",
-        "haptic_dob.nodes.environment_node:EnvironmentNode",
-    ),
-    "observer_node": ("haptic_dob", "observer_node", "haptic_dob.nodes.observer_node:ObserverNode"),
-    "controller_node": (
-        "haptic_dob",
-        "controller_node",
-        "haptic_dob.nodes.controller_node:ControllerNode",
-    ),
-    "recorder_node": ("haptic_dob", "recorder_node", "haptic_dob.nodes.recorder_node:RecorderNode"),
-    "device_node": ("haptic_sim", "device_node", "haptic_sim.nodes.device_node:DeviceNode"),
-}
-START_ORDER = (
-    "recorder_node",
-    "environment_node",
-    "observer_node",
-    "controller_node",
-    "device_node",
-)
+__all__ = ["NODES", "START_ORDER", "command", "main", "plan", "resolved_params"]
 
 
 @dataclass
-class NodeSpec:
-    """One node to start: name, executable and its ROS arguments."""
+class ProcessSpec:
+    """One process to start: its nodes, the executable and its arguments.
+
+    ``name`` is the node's name, or the nodes' names joined by ``, `` for a composed group.
+    """
+
+    @property
+    def label(self) -> str:
+        """How messages name the process."""
+        return self.name if len(self.nodes) == 1 else f"the process of {self.name}"
 
     name: str
+    nodes: list[str]
     executable: str
-    ros_args: list[str]
+    args: list[str]
 
 
 def executable(package: str, name: str) -> str:
@@ -186,19 +177,59 @@ def write_params_file(params: dict[str, Any], directory: Path) -> Path:
     return path
 
 
-def plan(params: dict[str, Any], params_file: Path, namespace: str) -> list[NodeSpec]:
-    """The nodes the parameters ask for, in start order, with their ROS arguments."""
-    out = []
-    for name in START_ORDER:
-        if name not in params:
-            continue
-        pkg, exe, _ = NODES[name]
-        args = ["--ros-args", "--params-file", str(params_file), "-r", f"__node:={name}"]
-        if namespace:
-            args += ["-r", f"__ns:={namespace}"]
-        out.append(NodeSpec(name, executable(pkg, exe), args))
-    if not out:
+def groups_for(
+    names: Sequence[str], composed: bool, processes: bool, given: Sequence[str]
+) -> list[list[str]]:
+    """Which of ``names`` share a process: ``--composed`` all, ``--processes`` none,
+    ``--group A,B`` (repeatable) the named ones, by default the loop's nodes."""
+    if sum((composed, processes, bool(given))) > 1:
+        raise CliError("--composed, --processes and --group are different choices: pick one")
+    if processes:
+        return []
+    if composed:
+        return [list(names)]
+    if not given:
+        return [[n for n in LOOP_NODES if n in names]]
+    groups, seen = [], set()
+    for text in given:
+        group = [n for n in text.split(",") if n]
+        unknown = [n for n in group if n not in NODES]
+        if unknown:
+            raise CliError(f"--group names unknown node(s) {', '.join(unknown)}")
+        twice = [n for n in group if n in seen]
+        if twice or len(set(group)) != len(group):
+            raise CliError(f"--group: {', '.join(twice or group)} named in more than one place")
+        seen.update(group)
+        groups.append([n for n in group if n in names])
+    return groups
+
+
+def plan(
+    params: dict[str, Any],
+    params_file: Path,
+    namespace: str,
+    groups: Sequence[Sequence[str]] = (),
+) -> list[ProcessSpec]:
+    """The processes the parameters ask for, in start order (the device's last), each with its
+    nodes and arguments; nodes of one group share a process (the container)."""
+    names = [n for n in START_ORDER if n in params]
+    if not names:
         raise CliError("the config starts no nodes")
+    ros = ["--ros-args", "--params-file", str(params_file)]
+    if namespace:
+        ros += ["-r", f"__ns:={namespace}"]
+    out: list[ProcessSpec] = []
+    grouped = [[n for n in START_ORDER if n in g and n in names] for g in groups]
+    grouped = [g for g in grouped if len(g) > 1]
+    for name in names:
+        group = next((g for g in grouped if name in g), None)
+        if group is None:
+            entry = NODES[name]
+            exe = executable(entry.package, entry.executable)
+            out.append(ProcessSpec(name, [name], exe, [*ros, "-r", f"__node:={name}"]))
+        elif name == group[-1]:  # the group starts where its last node would
+            exe = executable(*CONTAINER)
+            out.append(ProcessSpec(", ".join(group), group, exe, [*group, *ros]))
     return out
 
 
@@ -217,22 +248,22 @@ def network_env(network: str, peers: Sequence[str]) -> dict[str, str]:
     return env
 
 
-def select(specs: list[NodeSpec], only: Sequence[str]) -> list[NodeSpec]:
-    """The specs named in ``only`` (all when empty); unknown names are an error."""
+def select(names: Sequence[str], only: Sequence[str]) -> list[str]:
+    """The nodes named in ``only`` (all when empty); a name the config does not start is an
+    error."""
     if not only:
-        return specs
-    names = {s.name for s in specs}
+        return list(names)
     unknown = [n for n in only if n not in names]
     if unknown:
         raise CliError(
             f"--only names {', '.join(unknown)}, which the config does not start "
             f"(it starts {', '.join(sorted(names))})"
         )
-    return [s for s in specs if s.name in only]
+    return [n for n in names if n in only]
 
 
 def launch(
-    specs: list[NodeSpec],
+    specs: list[ProcessSpec],
     stop_timeout: float,
     duration: float | None,
     env: dict[str, str] | None = None,
@@ -245,11 +276,13 @@ def launch(
 
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     procs: dict[str, subprocess.Popen] = {}
+    labels = {s.name: s.label for s in specs}
+    device = next((s.name for s in specs if "device_node" in s.nodes), None)
     code = 0
     try:
         for spec in specs:
             procs[spec.name] = subprocess.Popen(
-                [spec.executable, *spec.ros_args],
+                [spec.executable, *spec.args],
                 start_new_session=True,
                 env={**os.environ, **(env or {})},
             )
@@ -258,14 +291,15 @@ def launch(
             done = {n: p.returncode for n, p in procs.items() if p.poll() is not None}
             if done:
                 name, rc = next(iter(done.items()))
-                if name == "device_node" and rc == 0:
+                if name == device and rc == 0:
                     print(
                         "haptic-launch: device_node finished its run; stopping the graph",
                         file=sys.stderr,
                     )
                 else:
                     print(
-                        f"ERROR: {name} exited with code {rc}; stopping the graph", file=sys.stderr
+                        f"ERROR: {labels[name]} exited with code {rc}; stopping the graph",
+                        file=sys.stderr,
                     )
                     code = 1
                 break
@@ -273,19 +307,19 @@ def launch(
                 break
             time.sleep(0.05)
     finally:
-        _stop_all(procs, stop_timeout)
+        _stop_all(procs, stop_timeout, device)
         for s, h in old.items():
             signal.signal(s, h)
     return code
 
 
-def _stop_all(procs: dict[str, subprocess.Popen], timeout: float) -> None:
-    """SIGTERM to every live node (device first), wait, then SIGKILL what is left.
+def _stop_all(procs: dict[str, subprocess.Popen], timeout: float, first: str | None) -> None:
+    """SIGTERM to every live process (the device's first), wait, then SIGKILL what is left.
 
     A node that runs handles SIGTERM as Ctrl-C (``run_nodes``); one still importing its modules
     ends quietly, where SIGINT would print a ``KeyboardInterrupt`` traceback.
     """
-    order = sorted(procs, key=lambda n: n != "device_node")
+    order = sorted(procs, key=lambda n: n != first)
     for name in order:
         p = procs[name]
         if p.poll() is None:
@@ -302,30 +336,6 @@ def _stop_all(procs: dict[str, subprocess.Popen], timeout: float) -> None:
             )
             p.kill()
             p.wait()
-
-
-def compose(specs: list[NodeSpec], executor: str | None) -> int:
-    """All nodes in this process under one executor (same parameters file and namespace)."""
-    import importlib
-
-    from haptic_msgs_py.ros.spin import run_nodes
-
-    classes = []
-    for spec in specs:
-        module, _, cls = NODES[spec.name][2].partition(":")
-        classes.append((spec.name, getattr(importlib.import_module(module), cls)))
-    ros_args = specs[0].ros_args
-    cleaned = ["haptic-launch"]
-    i = 0
-    while i < len(ros_args):  # drop the per-process node-name remap
-        if ros_args[i] == "-r" and ros_args[i + 1].startswith("__node:="):
-            i += 2
-            continue
-        cleaned.append(ros_args[i])
-        i += 1
-    return run_nodes(
-        lambda ctx: [cls(context=ctx, name=name) for name, cls in classes], cleaned, executor
-    )
 
 
 def normalize_namespace(namespace: str) -> str:
@@ -363,49 +373,63 @@ def set_rt_priority(priority: int) -> None:
         ) from None
 
 
-def command(
-    config: str,
-    namespace: str,
-    composed: bool,
-    sets: Sequence[str],
-    stop_timeout: float,
-    duration: float | None,
-    executor: str | None,
-    only: Sequence[str] = (),
-    network: str = "localhost",
-    peers: Sequence[str] = (),
-    record: str | None = None,
-    record_storage: str = "mcap",
-    rt_priority: int | None = None,
-    pin: bool = False,
-    cpu_latency_us: int | None = None,
-) -> int:
+@dataclass(frozen=True)
+class LaunchOptions:
+    """What ``haptic-launch`` was asked for (its command line, parsed)."""
+
+    config: str
+    namespace: str = ""
+    sets: Sequence[str] = ()
+    composed: bool = False
+    processes: bool = False
+    groups: Sequence[str] = ()
+    stop_timeout: float = 5.0
+    duration: float | None = None
+    executor: str | None = None
+    only: Sequence[str] = ()
+    network: str = "localhost"
+    peers: Sequence[str] = ()
+    record: str | None = None
+    record_storage: str = "mcap"
+    rt_priority: int | None = None
+    pin: bool = False
+    cpu_latency_us: int | None = None
+
+
+def command(opts: LaunchOptions) -> int:
     """Resolve, plan and run; raises ``CliError`` on bad input."""
     import tempfile
 
-    namespace = normalize_namespace(namespace)
-    path = resolve_config(config)
-    params = resolved_params(path, parse_sets(sets))
-    if record:
-        add_recorder(params, record, record_storage)
-    if pin:
-        if composed:
-            raise CliError("--pin places the nodes' processes; --composed runs one process")
+    namespace = normalize_namespace(opts.namespace)
+    path = resolve_config(opts.config)
+    params = resolved_params(path, parse_sets(opts.sets))
+    if opts.record:
+        add_recorder(params, opts.record, opts.record_storage)
+    names = select([n for n in START_ORDER if n in params], opts.only)
+    groups = groups_for(names, opts.composed, opts.processes, opts.groups)
+    if opts.pin:
+        shared = [g for g in groups if len(g) > 1]
+        if shared:
+            raise CliError(
+                f"--pin places node processes on CPUs, and {', '.join(shared[0])} share one "
+                "(the loop is composed by default): add --processes"
+            )
         print(f"haptic-launch: CPUs {add_pinning(params)}", file=sys.stderr)
-    if cpu_latency_us is not None:
-        add_cpu_latency(params, cpu_latency_us)
-        check_cpu_latency_request(cpu_latency_us)
-    net = network_env(network, peers)
-    if rt_priority is not None:  # the nodes started below inherit the policy
-        set_rt_priority(rt_priority)
+    if opts.cpu_latency_us is not None:
+        add_cpu_latency(params, opts.cpu_latency_us)
+        check_cpu_latency_request(opts.cpu_latency_us)
+    net = network_env(opts.network, opts.peers)
+    if opts.rt_priority is not None:  # the nodes started below inherit the policy
+        set_rt_priority(opts.rt_priority)
+    if opts.executor:
+        net["HAPTIC_DOB_EXECUTOR"] = opts.executor
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
-        specs = select(plan(params, write_params_file(params, Path(tmp)), namespace), only)
-        if composed:
-            os.environ.update(net)
-            return compose(specs, executor)
-        if executor:
-            net["HAPTIC_DOB_EXECUTOR"] = executor
-        return launch(specs, stop_timeout, duration, net)
+        chosen = {n: v for n, v in params.items() if n == "/**" or n in names}
+        specs = plan(chosen, write_params_file(params, Path(tmp)), namespace, groups)
+        for spec in specs:
+            if len(spec.nodes) > 1:
+                print(f"haptic-launch: {', '.join(spec.nodes)} in one process", file=sys.stderr)
+        return launch(specs, opts.stop_timeout, opts.duration, net)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -414,7 +438,20 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("config", help="session YAML (a path, or an installed name like slide_sim)")
     p.add_argument("--namespace", default="", help="namespace of every node (one device per ns)")
     p.add_argument(
-        "--composed", action="store_true", help="run all nodes in this process under one executor"
+        "--composed", action="store_true", help="run every node in one process (one executor)"
+    )
+    p.add_argument(
+        "--processes",
+        action="store_true",
+        help="run every node in a process of its own (default: the loop's four nodes share one, "
+        "their messages handed over in process; a recorder runs apart)",
+    )
+    p.add_argument(
+        "--group",
+        action="append",
+        default=[],
+        metavar="NODE,NODE[,...]",
+        help="these nodes share a process (repeatable; nodes in no group run alone)",
     )
     p.add_argument(
         "--set",
@@ -495,21 +532,25 @@ def main(argv: list[str] | None = None) -> int:
     peers = [h for h in a.peers.split(",") if h]
     return run(
         lambda: command(
-            a.config,
-            a.namespace,
-            a.composed,
-            a.set,
-            a.stop_timeout,
-            a.duration,
-            a.executor,
-            only,
-            a.network,
-            peers,
-            a.record,
-            a.record_storage,
-            a.rt_priority,
-            a.pin,
-            a.cpu_latency,
+            LaunchOptions(
+                config=a.config,
+                namespace=a.namespace,
+                sets=a.set,
+                composed=a.composed,
+                processes=a.processes,
+                groups=a.group,
+                stop_timeout=a.stop_timeout,
+                duration=a.duration,
+                executor=a.executor,
+                only=only,
+                network=a.network,
+                peers=peers,
+                record=a.record,
+                record_storage=a.record_storage,
+                rt_priority=a.rt_priority,
+                pin=a.pin,
+                cpu_latency_us=a.cpu_latency,
+            )
         )
     )
 

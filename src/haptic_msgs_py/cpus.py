@@ -85,3 +85,38 @@ def placement(nodes: Iterable[str], cpus: Sequence[int]) -> dict[str, list[int]]
 def describe(assigned: Mapping[str, Sequence[int]]) -> str:
     """``device_node: 0, controller_node: 0, ...`` for a log line."""
     return ", ".join(f"{n}: {','.join(map(str, c))}" for n, c in assigned.items())
+
+
+def _cpu_times() -> tuple[float, float] | None:
+    """(idle, total) jiffies summed over every CPU (Linux ``/proc/stat``), None elsewhere."""
+    try:
+        with open("/proc/stat", encoding="ascii") as fh:
+            fields = fh.readline().split()[1:]
+    except OSError:
+        return None
+    values = [float(v) for v in fields]
+    idle = values[3] + (values[4] if len(values) > 4 else 0.0)  # idle + iowait
+    return idle, sum(values[:8])
+
+
+def free_cpus(sample_s: float = 0.5) -> float:
+    """How many of this process's CPUs are idle now: the machine's idle share over ``sample_s``
+    seconds times the CPUs this process may use (their count where the system cannot say)."""
+    import time
+
+    usable = len(available_cpus())
+    before = _cpu_times()
+    if before is None:
+        return float(usable)
+    time.sleep(sample_s)
+    after = _cpu_times()
+    if after is None or after[1] <= before[1]:
+        return float(usable)
+    idle_share = (after[0] - before[0]) / (after[1] - before[1])
+    return max(0.0, min(1.0, idle_share)) * usable
+
+
+def workers_for(processes_per_job: int, free: float | None = None) -> int:
+    """Jobs to run at once so that each of their busy processes has a free CPU (at least one)."""
+    free = free_cpus() if free is None else free
+    return max(1, int((free + 0.25) // processes_per_job))

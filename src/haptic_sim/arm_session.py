@@ -1,12 +1,8 @@
 """The multi-DOF batch runner: one simulated arm session in-process, node-graph cycle timing.
 
-Per cycle k, in the order the node graph runs them (as ``session.py`` does for the slide):
-
-1. the device reports sample k (``SimulatedArm.sample``);
-2. the environment computes the wall force from the end-effector pose and twist of sample k;
-3. the observer updates with sample k (positions, velocities, effort applied over [k-1, k));
-4. the controller computes command k from the stamp-k inputs its mode needs;
-5. the device holds command k over [k, k+1) and steps to k+1.
+Per cycle k, as ``session.py`` does for the slide: the device reports sample k
+(``SimulatedArm.sample``), the cycle of ``haptic_dob.cycle`` (wall force, estimate, command k)
+answers it, and the device holds command k over [k, k+1) and steps to k+1.
 
 ``exact_force=True`` replaces the observer's wrench at the controller's DOB input by the exact
 one (thesis section 5.2.2's comparison): the disturbance the observer would see without lag,
@@ -27,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from haptic_dob.control import ImpedanceController, ImpedanceLaw
+from haptic_dob.cycle import LoopCycle
 from haptic_dob.environment import VirtualWall
 from haptic_dob.models.base import DeviceModel
 from haptic_dob.models.factory import build_model
@@ -179,8 +176,9 @@ def run_arm_session(config: ArmSessionConfig, cycles: int | None = None) -> ArmS
     if obs_model.dof != device.dof:
         raise ValueError(f"observer model has {obs_model.dof} joints, the plant {device.dof}")
     observer = config.observer.build(obs_model, device.dt)
-    controller = ImpedanceController(obs_model, config.law)
-    wall = config.wall
+    cycle = LoopCycle(
+        config.wall, observer, ImpedanceController(obs_model, config.law), device.period_ns
+    )
     dof = device.dof
     # warm-up: the device held at rest (its actuators balance the true gravity) while the
     # observer converges; the record starts at the release
@@ -207,10 +205,7 @@ def run_arm_session(config: ArmSessionConfig, cycles: int | None = None) -> ArmS
         joint["q_true"][k] = device.q
         cart["ee_true"][k] = obs_model._forward_kinematics(device.q)
         d_exact = exact_disturbance(device, obs_model)
-        f_wall = wall.force(s.ee_position, s.ee_velocity)
-        d_hat = observer.update(s.q, s.qd, s.effort)
-        fe = observer.wrench(s.q)
-        f_est = (float(fe[0]), float(fe[1]), float(fe[2]))
+        f_used: tuple[float, float, float] | None = None
         if config.exact_force:
             fx = dls_transpose_solve(
                 obs_model._jacobian(device.q),
@@ -219,9 +214,17 @@ def run_arm_session(config: ArmSessionConfig, cycles: int | None = None) -> ArmS
                 observer.dls_damping_m,
             )
             f_used = (float(fx[0]), float(fx[1]), float(fx[2]))
-        else:
-            f_used = f_est
-        tau = controller.command(s.q, f_wall, s.wrench_measured, f_used)
+        f_wall, f_est, tau = cycle.step(
+            s.stamp_ns,
+            s.q,
+            s.qd,
+            s.effort,
+            s.ee_position,
+            s.ee_velocity,
+            s.wrench_measured,
+            estimate_override=f_used,
+        )
+        d_hat = observer.estimate
         device.apply(tau)
         joint["q"][k] = s.q
         joint["qd"][k] = s.qd
@@ -234,6 +237,6 @@ def run_arm_session(config: ArmSessionConfig, cycles: int | None = None) -> ArmS
         cart["tip_force"][k] = s.hand_force
         cart["force_measured"][k] = s.wrench_measured
         cart["force_estimated"][k] = f_est
-        cart["force_used"][k] = f_used
+        cart["force_used"][k] = f_used or f_est
     t = np.arange(n) * device.dt
     return ArmSessionResult(config=config, t=t, **joint, **cart)

@@ -1,12 +1,8 @@
 """The batch runner: one simulated session in-process, with the node graph's exact cycle timing.
 
-Per cycle k, in the order the node graph runs them:
-
-1. the device reports sample k (``SimulatedSlide.sample``);
-2. the environment computes the wall force from the end-effector pose and twist of sample k;
-3. the observer updates with sample k (positions, velocities, effort applied over [k-1, k));
-4. the controller computes command k from the stamp-k inputs its mode needs;
-5. the device holds command k over [k, k+1) and steps to k+1.
+Per cycle k: the device reports sample k (``SimulatedSlide.sample``), the cycle of
+``haptic_dob.cycle`` (wall force, estimate, command k, the stages the node graph runs) answers
+it, and the device holds command k over [k, k+1) and steps to k+1.
 
 Deterministic for a given seed; the node graph in lockstep reproduces it to the bit.
 """
@@ -24,6 +20,7 @@ import numpy as np
 from haptic_dob.analysis.energy import passivity_observer
 from haptic_dob.analysis.transparency import transparency
 from haptic_dob.control import ImpedanceController, ImpedanceLaw
+from haptic_dob.cycle import LoopCycle
 from haptic_dob.environment import VirtualWall
 from haptic_dob.models.slide import SlideParams
 from haptic_dob.observer import ObserverSettings
@@ -208,8 +205,9 @@ def run_session(config: SessionConfig, cycles: int | None = None) -> SessionResu
         raise ValueError(f"a batch session needs at least one cycle, got {n}")
     obs_model = (config.observer_model or config.model).model()
     observer = config.observer.build(obs_model, device.dt)
-    controller = ImpedanceController(obs_model, config.law)
-    wall = config.wall
+    cycle = LoopCycle(
+        config.wall, observer, ImpedanceController(obs_model, config.law), device.period_ns
+    )
     axis = device.model.axis
     ax0, ax1, ax2 = (float(a) for a in axis)
 
@@ -217,11 +215,9 @@ def run_session(config: SessionConfig, cycles: int | None = None) -> SessionResu
     for k in range(n):
         s = device.sample()
         x_true = device.x
-        f_wall = wall.force(s.ee_position, s.ee_velocity)
-        observer.update(s.q, s.qd, s.effort)
-        fe = observer.wrench(s.q)
-        f_est = (float(fe[0]), float(fe[1]), float(fe[2]))
-        tau = controller.command(s.q, f_wall, s.wrench_measured, f_est)
+        f_wall, f_est, tau = cycle.step(
+            s.stamp_ns, s.q, s.qd, s.effort, s.ee_position, s.ee_velocity, s.wrench_measured
+        )
         device.apply(tau)
         fm, fh = s.wrench_measured, s.hand_force
         rec[k] = (

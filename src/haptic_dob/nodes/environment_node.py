@@ -8,17 +8,18 @@ from typing import Any
 
 from rclpy.context import Context
 
+from haptic_dob.cycle import wall_force
 from haptic_dob.environment import VirtualWall
 from haptic_dob.nodes.common import loop_specs, main_for, process_specs
-from haptic_msgs_py import wire
-from haptic_msgs_py.convert import read_linear, read_position, write_force
+from haptic_msgs_py import codecs
 from haptic_msgs_py.params import ParamSpec, build, specs_of
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.diagnostics import OK, WARN, Diagnostics, Report
+from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
 from haptic_msgs_py.ros.params import ParameterTable
-from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
 from haptic_msgs_py.ros.spin import LoopNode
-from haptic_msgs_py.topics import EE_POSE, EE_TWIST, SESSION_TOPICS, WRENCH_DESIRED
+from haptic_msgs_py.topics import EE_POSE, EE_TWIST, WRENCH_DESIRED
+from haptic_msgs_py.values import StampedVector
 
 
 def environment_node_specs() -> list[ParamSpec]:
@@ -33,12 +34,13 @@ class EnvironmentNode(LoopNode):
         super().__init__(name, context=context)
         self.params = ParameterTable(self, environment_node_specs(), self._settings, self._apply)
         self.wall: VirtualWall = self.params.settings
-        self._pose: Any = None
-        self._twist: Any = None
-        self._out = wire.wrench_stamped(self.params.values["base_frame"])
-        self._pub = RawPublisher(self, SESSION_TOPICS[WRENCH_DESIRED], WRENCH_DESIRED, qos.LOOP)
-        raw_subscription(self, SESSION_TOPICS[EE_POSE], EE_POSE, self._on_pose, qos.LOOP_IN)
-        raw_subscription(self, SESSION_TOPICS[EE_TWIST], EE_TWIST, self._on_twist, qos.LOOP_IN)
+        self._pose: StampedVector | None = None
+        self._twist: StampedVector | None = None
+        self._pub = LoopPublisher(
+            self, WRENCH_DESIRED, codecs.WRENCH, qos.LOOP, self.params.values["base_frame"]
+        )
+        LoopSubscription(self, EE_POSE, codecs.POSE, self._on_pose, qos.LOOP_IN)
+        LoopSubscription(self, EE_TWIST, codecs.TWIST, self._on_twist, qos.LOOP_IN)
         self.diagnostics = Diagnostics(self, self._report)
 
     def _report(self) -> Report:
@@ -61,26 +63,22 @@ class EnvironmentNode(LoopNode):
         self.wall = wall
         self.get_logger().info(f"wall now {wall}")
 
-    def _on_pose(self, msg: Any) -> None:
-        self._pose = msg
-        self._emit()
+    def _on_pose(self, pose: StampedVector) -> None:
+        self._pose = pose
+        twist = self._twist
+        if twist is not None and twist.stamp_ns == pose.stamp_ns:
+            self._emit(pose, twist)
 
-    def _on_twist(self, msg: Any) -> None:
-        self._twist = msg
-        self._emit()
+    def _on_twist(self, twist: StampedVector) -> None:
+        self._twist = twist
+        pose = self._pose
+        if pose is not None and pose.stamp_ns == twist.stamp_ns:
+            self._emit(pose, twist)
 
-    def _emit(self) -> None:
-        pose, twist = self._pose, self._twist
-        if pose is None or twist is None:
-            return
-        a, b = pose.header.stamp, twist.header.stamp
-        if a.sec != b.sec or a.nanosec != b.nanosec:
-            return
-        force = self.wall.force(read_position(pose), read_linear(twist))
-        out = self._out
-        out.header.stamp = a
-        write_force(out, force)
-        self._pub.publish(out)
+    def _emit(self, pose: StampedVector, twist: StampedVector) -> None:
+        self._pub.publish(
+            StampedVector(pose.stamp_ns, wall_force(self.wall, pose.vector, twist.vector))
+        )
         self.diagnostics.tick()
 
 

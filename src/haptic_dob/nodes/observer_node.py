@@ -17,20 +17,21 @@ import numpy as np
 from rclpy.context import Context
 from std_srvs.srv import Trigger
 
+from haptic_dob.control import ZERO_FORCE, Force
+from haptic_dob.cycle import estimate
 from haptic_dob.models.base import DeviceModel
 from haptic_dob.models.factory import build_model, model_specs
 from haptic_dob.nodes.common import loop_specs, main_for, process_specs
 from haptic_dob.observer import DisturbanceObserver, ObserverSettings
-from haptic_msgs_py import wire
-from haptic_msgs_py.convert import write_force
+from haptic_msgs_py import codecs
 from haptic_msgs_py.params import ParamSpec, build, specs_of
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.diagnostics import ERROR, OK, WARN, Diagnostics, Report
+from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
 from haptic_msgs_py.ros.params import ParameterTable
-from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
 from haptic_msgs_py.ros.spin import LoopNode
-from haptic_msgs_py.stamps import to_ns
-from haptic_msgs_py.topics import EFFORT_ESTIMATE, JOINT_STATES, SESSION_TOPICS, WRENCH_ESTIMATE
+from haptic_msgs_py.topics import EFFORT_ESTIMATE, JOINT_STATES, WRENCH_ESTIMATE
+from haptic_msgs_py.values import JointSample, StampedVector
 
 
 class JointMap:
@@ -38,8 +39,8 @@ class JointMap:
 
     def __init__(self, joint_names: Sequence[str]) -> None:
         self.joint_names = tuple(joint_names)
-        self._names: list[str] | None = None
-        self._index: list[int] | None = None
+        self._names: tuple[str, ...] | None = None
+        self._index: list[int] = []
 
     def index(self, names: Sequence[str], n_values: int) -> list[int]:
         """Positions of the model's joints in a message with ``names`` (ValueError if missing)."""
@@ -50,8 +51,8 @@ class JointMap:
                     f"model order, got {n_values}"
                 )
             return list(range(n_values))
-        if self._names is not None and list(names) == self._names:
-            return self._index  # type: ignore[return-value]
+        if names == self._names:  # the same names as the last message (tuples)
+            return self._index
         where = {n: i for i, n in enumerate(names)}
         missing = [j for j in self.joint_names if j not in where]
         if missing:
@@ -59,7 +60,7 @@ class JointMap:
                 f"joint_states lacks joint(s) {', '.join(missing)} of the model "
                 f"(it has: {', '.join(names)})"
             )
-        self._names = list(names)
+        self._names = tuple(names)
         self._index = [where[j] for j in self.joint_names]
         return self._index
 
@@ -92,20 +93,16 @@ class ObserverNode(LoopNode):
         self.gaps = 0  # samples that came more than one period after the previous one
         self._prev_q: list[float] | None = None
         self._bad_input_logged = ""
-        self._wrench = wire.wrench_stamped(values["base_frame"])
-        self._effort = wire.joint_state(self.model.joint_names, values["ee_frame"])
-        self._pub_wrench = RawPublisher(
-            self, SESSION_TOPICS[WRENCH_ESTIMATE], WRENCH_ESTIMATE, qos.LOOP
+        self._force: Force = ZERO_FORCE
+        self._names = tuple(self.model.joint_names)
+        self._pub_wrench = LoopPublisher(
+            self, WRENCH_ESTIMATE, codecs.WRENCH, qos.LOOP, values["base_frame"]
         )
-        self._pub_effort = RawPublisher(
-            self, SESSION_TOPICS[EFFORT_ESTIMATE], EFFORT_ESTIMATE, qos.LOOP
+        self._pub_effort = LoopPublisher(  # for evaluation: sent only while someone reads it
+            self, EFFORT_ESTIMATE, codecs.JOINT_STATE, qos.LOOP, values["ee_frame"], on_demand=True
         )
-        raw_subscription(
-            self,
-            SESSION_TOPICS[JOINT_STATES],
-            JOINT_STATES,
-            self._on_joint_states,
-            qos.ESTIMATOR_IN,
+        LoopSubscription(
+            self, JOINT_STATES, codecs.JOINT_STATE, self._on_joint_states, qos.ESTIMATOR_IN
         )
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.diagnostics = Diagnostics(self, self._report)
@@ -148,26 +145,25 @@ class ObserverNode(LoopNode):
         res.message = "observer re-zeroed; it re-initialises on the next sample"
         return res
 
-    def _on_joint_states(self, msg: Any) -> None:
-        st = msg.header.stamp
-        now = to_ns(st.sec, st.nanosec)
+    def _on_joint_states(self, js: JointSample) -> None:
+        now = js.stamp_ns
         if now < self._last_ns:
             return
         if now == self._last_ns:  # the same sample again: answer it again
-            self._publish(st)
+            self._publish(now)
             return
         try:
-            idx = self.joints.index(msg.name, len(msg.position))
-            n = len(msg.name) or len(msg.position)
-            q = pick(msg.position, idx, "position", n)
-            if len(msg.velocity):
-                qd = pick(msg.velocity, idx, "velocity", n)
+            idx = self.joints.index(js.name, len(js.position))
+            n = len(js.name) or len(js.position)
+            q = pick(js.position, idx, "position", n)
+            if len(js.velocity):
+                qd = pick(js.velocity, idx, "velocity", n)
             elif self._prev_q is not None and now > self._last_ns:
                 dt = (now - self._last_ns) * 1e-9
                 qd = [(a - b) / dt for a, b in zip(q, self._prev_q, strict=True)]
             else:
                 qd = [0.0] * len(q)
-            tau = pick(msg.effort, idx, "effort", n) if len(msg.effort) else [0.0] * len(q)
+            tau = pick(js.effort, idx, "effort", n) if len(js.effort) else [0.0] * len(q)
             if not all(map(math.isfinite, q + qd + tau)):
                 raise ValueError("joint_states holds NaN or inf")
         except ValueError as exc:
@@ -183,19 +179,17 @@ class ObserverNode(LoopNode):
         self._prev_q = q
         self._last_ns = now
         self._bad_input_logged = ""
-        self.observer.update(q, qd, tau)
+        self._force = estimate(self.observer, q, qd, tau)
         self.diagnostics.tick()
-        self._publish(st, q)
+        self._publish(now)
 
-    def _publish(self, stamp: Any, q: list[float] | None = None) -> None:
-        if q is not None:
-            force = self.observer.wrench(q)
-            write_force(self._wrench, force)
-            self._effort.effort = self.observer.estimate
-        self._wrench.header.stamp = stamp
-        self._effort.header.stamp = stamp
-        self._pub_wrench.publish(self._wrench)
-        self._pub_effort.publish(self._effort)
+    def _publish(self, stamp_ns: int) -> None:
+        """The estimate of sample ``stamp_ns``: the wrench first (the controller may wait for
+        it), the joint effort only when someone takes it."""
+        self._pub_wrench.publish(StampedVector(stamp_ns, self._force))
+        if self._pub_effort.wanted:
+            effort = tuple(self.observer.estimate.tolist())
+            self._pub_effort.publish(JointSample(stamp_ns, self._names, (), (), effort))
 
     def _complain(self, reason: str) -> None:
         if reason != self._bad_input_logged:  # once per distinct problem, not at 1 kHz

@@ -31,6 +31,7 @@ from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
+from haptic_msgs_py.bus import bus_for
 from haptic_msgs_py.cpu_latency import NO_REQUEST, hold, strictest
 from haptic_msgs_py.cpus import checked_cpus, pin_process
 
@@ -38,6 +39,9 @@ EXECUTORS = ("events", "single")
 DRAIN_BUDGET_S = 2.0  # at most this long for the work-off and the acknowledgements at a stop
 DRAIN_QUIET_S = 0.2  # inputs are worked off when the marker did not change for this long
 WORK_OFF_S = 0.5  # ... or after this long
+#: while nodes of this process hand the loop around in process (lockstep), the executor (DDS
+#: from other processes, services, timers) gets a turn at least this often (s)
+SOON_SLICE_S = 0.004
 
 
 class LoopNode(Node):
@@ -168,20 +172,22 @@ def run_nodes(
             prof.enable()
         spin_once = ex.spin_once
         monotonic = time.monotonic
-        done = False
-        while not received and not done and context.ok():
+        bus = bus_for(context)
+        while not received and context.ok():
+            if any(n.finished for n in loop_nodes):
+                break
+            now = monotonic()
             timeout = 0.05
             due_nodes = False
             for n in loop_nodes:
-                if n.finished:
-                    done = True
                 due = n.next_wakeup()
                 if due is not None:
                     due_nodes = True
-                    timeout = min(timeout, due - monotonic())
-            if done:
-                break
-            if timeout > 0.0:
+                    timeout = min(timeout, due - now)
+            if bus.soon:  # nodes composed here turn the loop over in process (lockstep)
+                bus.run_soon(SOON_SLICE_S)
+                spin_once(timeout_sec=0.0)  # then the executor gets a turn
+            elif timeout > 0.0:
                 spin_once(timeout_sec=timeout)
             if due_nodes:
                 now = monotonic()

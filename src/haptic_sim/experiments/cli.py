@@ -9,8 +9,10 @@ Parts (``--parts``, all by default):
 - ``dob``: why the thesis's DOB wall stayed quiet at Kf = 100 (batch, the simulator's knobs);
 - ``phantom``: thesis section 5.2 on the PHANToM 1.5 (batch).
 
-Graph runs go ``--workers`` at a time, each on a ROS domain of its own; a run whose bag is
-complete is not run again, so an interrupted experiment resumes (``--fresh`` starts over). The
+Graph runs go ``--workers`` at a time, each on a ROS domain of its own (by default as many as the
+free CPUs carry: a run keeps two processes busy, its composed loop and its recorder; batch jobs
+one each); a run whose bag is complete is not run again, so an interrupted experiment resumes
+(``--fresh`` starts over). The
 bags are analysed as ``haptic-analyze`` does (``runs/*/analysis.json``), and ``report.md`` with
 its figures and ``results.json`` is written to ``--out``. ``--quick`` runs only OL, CL Kf=2 and
 DOB Kf=1 at 800 N/m for 20 s (the demo).
@@ -19,7 +21,6 @@ DOB Kf=1 at 800 N/m for 20 s (the demo).
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import signal
 import sys
@@ -31,6 +32,8 @@ from typing import Any
 from haptic_dob.cli import ArgumentParser, CliError, run
 
 PARTS = ("ch7", "ch6", "map", "dob", "phantom")
+#: busy processes of one recorded graph run: the composed loop and the recorder
+GRAPH_RUN_PROCESSES = 2
 QUICK_CONTROLLERS = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0)]
 QUICK_WALLS = [800.0]
 QUICK_DURATION_S = 20.0
@@ -67,16 +70,17 @@ def command(
     config: str,
     parts_text: str,
     quick: bool,
-    workers: int,
+    workers: int | None,
     seed: int,
     fresh: bool,
 ) -> int:
     """Run the chosen parts, analyse, write the report; raises on bad input or a failed run."""
     from haptic_dob.configs import resolve_config
+    from haptic_msgs_py.cpus import free_cpus, workers_for
     from haptic_sim.experiments import graph_runs, plan, report, results
     from haptic_sim.session import SessionConfig
 
-    if workers < 1:
+    if workers is not None and workers < 1:
         raise CliError(f"--workers must be >= 1, got {workers}")
     if seed < 0:
         raise CliError(f"--seed must be >= 0, got {seed}")
@@ -99,12 +103,22 @@ def command(
         "seed": seed,
         "parts": parts,
     }
-    _say(f"haptic-experiment: {', '.join(parts)} -> {root}/ ({workers} workers)")
+    if workers is None:
+        free = free_cpus()
+        graph_workers, batch_workers = workers_for(GRAPH_RUN_PROCESSES, free), workers_for(1, free)
+        basis = f"{free:.1f} CPUs free"
+    else:
+        graph_workers = batch_workers = workers
+        basis = "--workers"
+    _say(
+        f"haptic-experiment: {', '.join(parts)} -> {root}/ ({graph_workers} graph run(s) and "
+        f"{batch_workers} batch job(s) at a time: {basis})"
+    )
 
     # --- batch parts first (they use every core for a short while) -----------------------------
     batch = [p for p in parts if p in ("map", "dob", "phantom")]
     if batch:
-        with ProcessPoolExecutor(workers) as ex:
+        with ProcessPoolExecutor(batch_workers) as ex:
             if "map" in parts:
                 t0 = time.monotonic()
                 res["map"] = _cached(root / "batch" / "map.json", lambda: _map(base, ex))
@@ -150,14 +164,14 @@ def command(
     if runs:
         t0 = time.monotonic()
         sim = sum(r.duration_s for r in runs)
-        _say(f"{len(runs)} node-graph runs ({sim:g} s simulated), {workers} at a time")
+        _say(f"{len(runs)} node-graph runs ({sim:g} s simulated), {graph_workers} at a time")
         try:
-            graph_runs.execute_all(root, runs, workers, rtf_guess=1.0, progress=_say)
+            graph_runs.execute_all(root, runs, graph_workers, rtf_guess=1.0, progress=_say)
         except RuntimeError as exc:
             raise CliError(str(exc).splitlines()[0] + " (see its launch.log)") from None
         timing["graph_runs"] = time.monotonic() - t0
         t0 = time.monotonic()
-        with ProcessPoolExecutor(workers) as ex:
+        with ProcessPoolExecutor(batch_workers) as ex:
             rows = list(ex.map(results.analyse_run, [root] * len(runs), runs))
         timing["analysis"] = time.monotonic() - t0
         _say(f"analysed {len(rows)} bags ({timing['analysis']:.0f} s)")
@@ -227,8 +241,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--workers",
         type=int,
-        default=min(2, os.cpu_count() or 1),
-        help="graph runs and batch jobs at a time (default: 2, or 1 on one core)",
+        default=None,
+        help="graph runs and batch jobs at a time (default: what the free CPUs carry, measured "
+        f"at the start: {GRAPH_RUN_PROCESSES} per graph run, 1 per batch job)",
     )
     p.add_argument("--seed", type=int, default=0, help="seed of the hand motion (default 0)")
     p.add_argument("--fresh", action="store_true", help="delete --out first instead of resuming")

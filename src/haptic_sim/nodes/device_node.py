@@ -34,20 +34,19 @@ import time
 from collections.abc import Mapping
 from typing import Any
 
-import numpy as np
 from rclpy.context import Context
 
 from haptic_dob.models.factory import model_specs
 from haptic_dob.nodes.common import CLOCK_MODES, loop_specs, main_for, process_specs
-from haptic_msgs_py import wire
-from haptic_msgs_py.convert import write_force, write_linear, write_position
+from haptic_msgs_py import codecs
 from haptic_msgs_py.params import ParamSpec
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.diagnostics import OK, WARN, Diagnostics, Report
+from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
 from haptic_msgs_py.ros.params import ParameterTable
-from haptic_msgs_py.ros.raw import RawPublisher, raw_subscription
+from haptic_msgs_py.ros.raw import raw_subscription
 from haptic_msgs_py.ros.spin import LoopNode
-from haptic_msgs_py.stamps import NS_PER_S, command_stamp
+from haptic_msgs_py.stamps import NS_PER_S
 from haptic_msgs_py.topics import (
     CLOCK,
     EE_POSE,
@@ -56,9 +55,9 @@ from haptic_msgs_py.topics import (
     HAND_WRENCH,
     JOINT_STATES,
     RECORDER_PROGRESS,
-    SESSION_TOPICS,
     WRENCH_MEASURED,
 )
+from haptic_msgs_py.values import EffortCommand, JointSample, Stamp, StampedVector
 from haptic_sim.device import DeviceSample
 from haptic_sim.factory import build_device, simulation_specs
 from haptic_sim.latency import LatencyHistogram
@@ -75,7 +74,8 @@ def device_node_specs() -> list[ParamSpec]:
         ParamSpec(
             "command_timeout_s",
             0.005,
-            "realtime watchdog: zero effort when no valid command came for this long",
+            "realtime watchdog: zero effort when no valid command came for this long of "
+            "simulated time (samples: a stall of the device's own process does not count)",
             "s",
             0.0005,
             1.0,
@@ -155,34 +155,31 @@ class DeviceNode(LoopNode):
         self.lockstep = v["clock_mode"] == "lockstep"
         cycles = round(v["duration_s"] * v["rate_hz"])
         self.last_k = cycles if cycles > 0 else None  # the run ends after publishing sample N
-        # messages, filled in place each cycle; one shared stamp object
-        self._stamp = wire.Time(sec=0, nanosec=0)
         base, ee = v["base_frame"], v["ee_frame"]
-        self._pose, self._twist = wire.pose_stamped(base), wire.twist_stamped(base)
-        self._measured, self._hand = wire.wrench_stamped(base), wire.wrench_stamped(base)
-        self._js = wire.joint_state(self.device.model.joint_names, ee)
-        self._clock_msg = wire.clock()
-        for m in (self._pose, self._twist, self._measured, self._hand, self._js):
-            m.header.stamp = self._stamp
-        self._clock_msg.clock = self._stamp
+        self._names = tuple(self.device.model.joint_names)
 
-        def pub(topic: str) -> RawPublisher:
-            return RawPublisher(self, SESSION_TOPICS[topic], topic, qos.LOOP)
+        def pub(topic: str, codec: codecs.Codec, frame: str) -> LoopPublisher:
+            return LoopPublisher(self, topic, codec, qos.LOOP, frame)
 
-        self._p_pose, self._p_twist = pub(EE_POSE), pub(EE_TWIST)
-        self._p_js, self._p_measured, self._p_hand = (
-            pub(JOINT_STATES),
-            pub(WRENCH_MEASURED),
-            pub(HAND_WRENCH),
+        self._p_pose, self._p_twist = (
+            pub(EE_POSE, codecs.POSE, base),
+            pub(EE_TWIST, codecs.TWIST, base),
+        )
+        self._p_js = pub(JOINT_STATES, codecs.JOINT_STATE, ee)
+        self._p_measured = pub(WRENCH_MEASURED, codecs.WRENCH, base)
+        # evaluation topics: sent only while someone listens
+        self._p_hand = LoopPublisher(
+            self, HAND_WRENCH, codecs.WRENCH, qos.LOOP, base, on_demand=True
         )
         self._p_clock = (
-            RawPublisher(self, "rosgraph_msgs/msg/Clock", CLOCK, qos.CLOCK)
+            LoopPublisher(self, CLOCK, codecs.CLOCK, qos.CLOCK, on_demand=True)
             if self.lockstep
             else None
         )
-        self._sub = raw_subscription(
-            self, SESSION_TOPICS[EFFORT_COMMAND], EFFORT_COMMAND, self._on_command, qos.LOOP_IN
+        self._sub = LoopSubscription(
+            self, EFFORT_COMMAND, codecs.EFFORT, self._on_command, qos.LOOP_IN
         )
+        self._bus = self._sub.bus
         self._recorder_ns: int | None = None  # newest stamp the slowest recorder has written
         self._recorders: dict[str, tuple[float, int]] = {}  # name -> (wall time, stamp)
         self._drain_until: float | None = None  # after the last sample: wait for the recorder
@@ -193,13 +190,14 @@ class DeviceNode(LoopNode):
             )
         self._zero = [0.0] * self.dof
         self._latest = self._zero
-        self._last_command_s = -math.inf
+        self._last_command_k = -1  # the sample k at which the newest valid command came
         self.refused = 0
         self.limited = 0
         self._refusing = False
         self.watchdog_tripped = False
         self.watchdog_trips = 0
         self._started = False
+        self._stepped = False  # lockstep: command k applied, sample k+1 not yet published
         self._ready_since: float | None = None
         self._t_first = 0.0
         self._deadline = time.monotonic() + 0.1
@@ -238,72 +236,72 @@ class DeviceNode(LoopNode):
 
     # --- publishing ------------------------------------------------------------------------
     def _publish(self, s: DeviceSample) -> None:
+        """Sample k to every topic: nodes in this process get it at once, depth first, in the
+        order that closes the loop soonest (the wall's inputs, the sensor, then the joints);
+        readers in other processes get it once the whole sample is out (``Bus.batch``)."""
         self._sent_s = time.monotonic()
-        st = self._stamp
-        st.sec, st.nanosec = divmod(s.stamp_ns, NS_PER_S)
-        write_position(self._pose, s.ee_position)
-        self._p_pose.publish(self._pose)
-        write_linear(self._twist, s.ee_velocity)
-        self._p_twist.publish(self._twist)
-        js = self._js
-        js.position, js.velocity, js.effort = np.array(s.q), np.array(s.qd), np.array(s.effort)
-        self._p_js.publish(js)
-        write_force(self._measured, s.wrench_measured)
-        self._p_measured.publish(self._measured)
-        # evaluation-only topics: skip the serialisation when nobody listens
-        if self._p_hand.get_subscription_count():
-            write_force(self._hand, s.hand_force)
-            self._p_hand.publish(self._hand)
-        if self._p_clock is not None and self._p_clock.get_subscription_count():
-            self._p_clock.publish(self._clock_msg)
+        k = s.stamp_ns
+        bus = self._bus
+        bus.begin()
+        try:
+            self._p_pose.publish(StampedVector(k, s.ee_position))
+            self._p_twist.publish(StampedVector(k, s.ee_velocity))
+            self._p_measured.publish(StampedVector(k, s.wrench_measured))
+            self._p_js.publish(JointSample(k, self._names, s.q, s.qd, s.effort))
+            # evaluation-only topics: built only when someone takes them
+            if self._p_hand.wanted:
+                self._p_hand.publish(StampedVector(k, s.hand_force))
+            if self._p_clock is not None and self._p_clock.wanted:
+                self._p_clock.publish(Stamp(k))
+        finally:
+            bus.end()
 
     # --- commands --------------------------------------------------------------------------
-    def _checked(self, data: Any) -> list[float] | None:
+    def _checked(self, data: tuple[float, ...]) -> list[float] | None:
         """The command clamped to the limits, or None when it is refused (wrong length, NaN)."""
-        data = data.tolist()
         if len(data) != self.dof or not all(map(math.isfinite, data)):
             self.refused += 1
             if not self._refusing:
                 self.get_logger().warning(
-                    f"refusing effort_command {data!r}: need {self.dof} finite values; "
+                    f"refusing effort_command {list(data)!r}: need {self.dof} finite values; "
                     "zero effort until a valid command"
                 )
                 self._refusing = True
             return None
         self._refusing = False
-        out = data
+        out = list(data)
+        limited = False
         for i, (e, lim) in enumerate(zip(data, self.limits, strict=True)):
             if e > lim or e < -lim:
-                if out is data:
-                    out = list(data)
-                    self.limited += 1
                 out[i] = lim if e > 0 else -lim
+                limited = True
+        if limited:
+            self.limited += 1
         return out
 
-    def _on_command(self, msg: Any) -> None:
-        dims = msg.layout.dim
-        stamp = command_stamp(dims[0].label) if dims else None
+    def _on_command(self, cmd: EffortCommand) -> None:
+        stamp = cmd.stamp_ns
         current = self.device.k * self.period_ns
         if self.lockstep:
             if not self._started or (stamp is not None and stamp != current):
                 return  # stale, duplicate, or before the run started
-            if self._drain_until is not None:
-                return  # the run is over: the last sample is out
-            effort = self._checked(msg.data)
+            if self._drain_until is not None or self._stepped:
+                return  # the run is over, or command k already moved the plant
+            effort = self._checked(cmd.effort)
             if effort is None:
                 effort = self._zero  # a refused command is zero effort; the loop goes on
             if self._recorder_lags():
                 self._held = effort  # the recorder's progress callback releases it
                 return
-            self._step(effort)
+            self._advance(effort)
             return
-        effort = self._checked(msg.data)
+        effort = self._checked(cmd.effort)
         if effort is None:
             self._latest = self._zero
             return
         now = time.monotonic()
         self._latest = effort
-        self._last_command_s = now
+        self._last_command_k = self.device.k
         if self.watchdog_tripped:
             self.watchdog_tripped = False
             self.get_logger().info(
@@ -313,7 +311,7 @@ class DeviceNode(LoopNode):
             self._command_k = self.device.k
             self._on_time += 1
             self._latency.add(now - self._sent_s)
-            self.device.prepare()  # the loop is idle until the next tick
+            self._bus.call_soon(self.device.prepare)  # the loop is idle until the next tick
 
     def _on_progress(self, msg: Any) -> None:
         st = msg.stamp
@@ -327,7 +325,7 @@ class DeviceNode(LoopNode):
             return
         if self._held is not None and not self._recorder_lags():
             effort, self._held = self._held, None
-            self._step(effort)
+            self._advance(effort)
 
     def _recorder_lags(self) -> bool:
         """A recorder is connected and more than ``max_recorder_lag_s`` behind sample k."""
@@ -336,15 +334,30 @@ class DeviceNode(LoopNode):
         lead = self.device.k * self.period_ns - self._recorder_ns
         return lead > self.params.values["max_recorder_lag_s"] * NS_PER_S
 
-    def _step(self, effort: list[float]) -> None:
+    def _advance(self, effort: list[float]) -> None:
+        """Command k reaches the plant: held over [k, k+1), the device steps to sample k+1.
+
+        In lockstep sample k+1 goes out once this cycle's publishes have returned (at once when
+        the command came from another process).
+        """
         self.device.apply(effort)
+        if self.lockstep:
+            self._stepped = True
+            self._bus.call_soon(self._send_sample)
+
+    def _send_sample(self) -> None:
+        """Publish the current sample; in lockstep arm the re-send and end the run at its end."""
+        self._stepped = False
         s = self.device.sample()
+        last = self.last_k is not None and s.k >= self.last_k and self._drain_until is None
+        if last:  # the run ends with this sample: a command that answers it moves nothing
+            self._drain_until = time.monotonic() + DRAIN_TIMEOUT_S
         self._publish(s)
         self.diagnostics.tick()
         if self.lockstep:
             self.device.prepare()  # while the others work on sample k
             self._deadline = self._sent_s + self.params.values["lockstep_timeout_s"]
-        if self.last_k is not None and s.k >= self.last_k and self._drain_until is None:
+        if last:
             wall = time.monotonic() - self._t_first
             sim = s.k * self.period_ns * 1e-9
             self.get_logger().info(
@@ -352,7 +365,6 @@ class DeviceNode(LoopNode):
                 f"real-time factor {sim / wall:.2f}"
             )
             # stay up (publishers alive) until a recorder has written the last sample
-            self._drain_until = time.monotonic() + DRAIN_TIMEOUT_S
             self._deadline = time.monotonic()
             self._check_drained()
 
@@ -403,7 +415,7 @@ class DeviceNode(LoopNode):
                 self.get_logger().warning("the recorder stopped reporting; the loop goes on")
                 self._recorder_ns = None
                 effort, self._held = self._held, None
-                self._step(effort)
+                self._advance(effort)
                 return
             self._deadline = now + self.params.values["lockstep_timeout_s"]
             self.get_logger().warning(
@@ -411,6 +423,9 @@ class DeviceNode(LoopNode):
                 f"{(k * self.period_ns - (self._recorder_ns or 0)) * 1e-9:.2f} s behind",
                 throttle_duration_sec=5.0,
             )
+            return
+        if self._stepped:  # sample k+1 is on its way (deferred work not run yet)
+            self._deadline = now + self.params.values["lockstep_timeout_s"]
             return
         if k == 0:
             self._publish(self.device.sample())  # start-up: a late subscriber may have missed it
@@ -446,14 +461,9 @@ class DeviceNode(LoopNode):
         missing = [w for w in wait_for if w not in names]
         if missing:
             return f"node{'s' if len(missing) > 1 else ''} {', '.join(missing)} in {ns}"
-        for pub, topic in (
-            (self._p_js, JOINT_STATES),
-            (self._p_pose, EE_POSE),
-            (self._p_twist, EE_TWIST),
-            (self._p_measured, WRENCH_MEASURED),
-        ):
-            if pub.get_subscription_count() < self.count_subscribers(topic):
-                return f"the subscribers of {topic} to match"
+        for pub in self._bus.publishers():  # this node's and any composed with it
+            if pub.readers < self.count_subscribers(pub.topic):
+                return f"the subscribers of {pub.topic} to match"
         if wait_for and self._sub.get_publisher_count() < 1:
             return f"a publisher of {EFFORT_COMMAND}"
         return ""
@@ -469,24 +479,34 @@ class DeviceNode(LoopNode):
         if self._command_k != self.device.k and self._on_time:
             self._late += 1  # counted once the loop has closed (the first command came)
         effort = self._latest
-        if now - self._last_command_s > self.params.values["command_timeout_s"]:
+        if self._watchdog_due():
             effort = self._zero
-            if not self.watchdog_tripped:
-                self.watchdog_tripped = True
-                self.watchdog_trips += 1
-                silent = now - self._last_command_s
-                self.get_logger().warning(
-                    f"watchdog: no valid {EFFORT_COMMAND} for "
-                    f"{'ever' if math.isinf(silent) else f'{silent * 1e3:.1f} ms'} "
-                    f"(limit {self.params.values['command_timeout_s'] * 1e3:g} ms): effort zeroed "
-                    f"({self.watchdog_trips} trips so far)",
-                    throttle_duration_sec=1.0,
-                )
-        self._step(effort)
+        self._advance(effort)
+        self._send_sample()
         self._deadline += period
         if now - self._deadline > period:  # fell behind by more than a period: resynchronise
             self._missed_ticks += int((now - self._deadline) / period)
             self._deadline = now + period
+
+    def _watchdog_due(self) -> bool:
+        """No valid command for ``command_timeout_s`` of simulated time (samples): trip, say so
+        once. The simulated plant moves only when the device ticks, so a stall of this process
+        (the host, the garbage collector) never trips it, while a silent controller trips it
+        within the timeout of the plant's time however late or bunched the ticks come."""
+        silent = self.device.k - self._last_command_k  # periods the newest command was held
+        timeout = self.params.values["command_timeout_s"]
+        if silent * self.period_ns <= timeout * NS_PER_S:
+            return False
+        if not self.watchdog_tripped:
+            self.watchdog_tripped = True
+            self.watchdog_trips += 1
+            held = "ever" if self._last_command_k < 0 else f"{silent} samples"
+            self.get_logger().warning(
+                f"watchdog: no valid {EFFORT_COMMAND} for {held} (limit {timeout * 1e3:g} ms of "
+                f"simulated time): effort zeroed ({self.watchdog_trips} trips so far)",
+                throttle_duration_sec=1.0,
+            )
+        return True
 
     # --- end -------------------------------------------------------------------------------
     def stats(self) -> dict[str, Any]:
@@ -537,7 +557,8 @@ class DeviceNode(LoopNode):
                 json.dump(self.stats(), fh, indent=2)
         self._latest = self._zero
         if not self.lockstep and self._started:
-            self._step(self._zero)
+            self._advance(self._zero)
+            self._send_sample()
         self.get_logger().info("shutdown: effort zeroed")
 
 

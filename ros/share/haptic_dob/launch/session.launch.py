@@ -1,10 +1,13 @@
-"""ros2 launch haptic_dob session.launch.py [config:=<yaml>] [namespace:=<ns>]
+"""ros2 launch haptic_dob session.launch.py [config:=<yaml>] [namespace:=<ns>] [composed:=true]
 
-The simulated session graph for the ROS 2 command line: one node per section of the config
-(device, environment, observer, controller, recorder), each with the config's ``/**`` values
-and its own section, in ``namespace``. The same plan as ``haptic-launch`` (which needs no
-ROS 2 command line), from the same YAML.
+The simulated session graph for the ROS 2 command line, the same plan as ``haptic-launch``
+(which needs no ROS 2 command line), from the same YAML: the loop's nodes (device, environment,
+observer, controller) in one process (``ros2 run haptic_dob container``, their messages handed
+over in process) unless ``composed:=false``, a recorder apart, in ``namespace``.
 """
+
+import tempfile
+from pathlib import Path
 
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
@@ -12,29 +15,51 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 from haptic_dob.configs import resolve_config
-from haptic_dob.launcher import NODES, START_ORDER, resolved_params
+from haptic_dob.launcher import NODES, START_ORDER, groups_for, resolved_params, write_params_file
+from haptic_dob.nodes.registry import CONTAINER
 
 
 def _nodes(context, *args, **kwargs):
     config = resolve_config(LaunchConfiguration("config").perform(context))
     namespace = LaunchConfiguration("namespace").perform(context)
+    composed = LaunchConfiguration("composed").perform(context).strip().lower()
+    if composed not in ("true", "false"):
+        raise ValueError(f"composed must be true or false, got {composed!r}")
     params = resolved_params(config, {})
     common = params.get("/**", {})
+    names = [n for n in START_ORDER if n in params]
+    groups = [
+        [n for n in START_ORDER if n in g]  # in start order, as haptic-launch plans them
+        for g in groups_for(names, False, composed == "false", ())
+        if len(g) > 1
+    ]
     out = []
-    for name in START_ORDER:
-        if name not in params:
-            continue
-        package, executable, _ = NODES[name]
-        out.append(
-            Node(
-                package=package,
-                executable=executable,
-                name=name,
-                namespace=namespace,
-                parameters=[{**common, **params[name]}],
-                output="screen",
+    for name in names:
+        group = next((g for g in groups if name in g), None)
+        if group is None:
+            package, executable, _ = NODES[name]
+            out.append(
+                Node(
+                    package=package,
+                    executable=executable,
+                    name=name,
+                    namespace=namespace,
+                    parameters=[{**common, **params[name]}],
+                    output="screen",
+                )
             )
-        )
+        elif name == group[-1]:  # one process for the group, where its last node would start
+            folder = Path(tempfile.mkdtemp(prefix="haptic-launch-"))
+            out.append(
+                Node(
+                    package=CONTAINER[0],
+                    executable=CONTAINER[1],
+                    arguments=list(group),
+                    namespace=namespace,
+                    parameters=[str(write_params_file(params, folder))],
+                    output="screen",
+                )
+            )
     return out
 
 
@@ -45,6 +70,9 @@ def generate_launch_description():
                                   description="session YAML: a path or an installed name"),
             DeclareLaunchArgument("namespace", default_value="",
                                   description="namespace of every node"),
+            DeclareLaunchArgument("composed", default_value="true",
+                                  description="the loop's four nodes in one process (true) or "
+                                              "each in its own (false)"),
             OpaqueFunction(function=_nodes),
         ]
     )

@@ -1,0 +1,64 @@
+"""How fast this machine turns the loop over, measured by the suite itself (once per layout).
+
+A test whose premise is real time at 1 kHz (the device ticking on the wall clock, commands due
+before the next tick) can only hold on a machine that turns the same loop over, in the same
+process layout, well inside a period. The measurement is a short lockstep run of that layout:
+its real-time factor is how many periods of loop work fit in one period of wall time. Below
+``REQUIRED_RTF`` such a test skips, saying the figure; every other test runs whatever the machine.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+import pytest
+
+from rosgraph import isolated_env
+
+ROOT = Path(__file__).resolve().parents[1]
+BIN = Path(sys.executable).parent
+#: the loop work of a cycle must fit in 5/6 of a period: a sixth of it left for the jitter of a
+#: loaded machine (the device's watchdog zeroes the force after five late periods)
+REQUIRED_RTF = 1.2
+MEASURE_S = 2.0  # simulated seconds of the lockstep measurement
+
+_measured: dict[tuple[tuple[str, ...], ...], float] = {}
+
+
+def lockstep_rtf(
+    groups: Sequence[Sequence[str]], mode: str = "OL", sets: Sequence[str] = ()
+) -> float:
+    """The lockstep real-time factor of the slide loop with ``groups`` sharing processes (nodes
+    in no group alone; ``[]``: four processes), in ``mode``, with ``sets`` (``haptic-launch
+    --set``); measured once per layout."""
+    key = (*(tuple(sorted(g)) for g in groups), (mode, *sets))
+    if key not in _measured:
+        argv = [str(BIN / "haptic-launch"), str(ROOT / "config" / "slide_sim.yaml")]
+        argv += [a for g in groups for a in ("--group", ",".join(g))] or ["--processes"]
+        argv += ["--set", f"device_node:duration_s={MEASURE_S}"]
+        argv += ["--set", f"controller_node:mode={mode}", "--set", "controller_node:kf=1.0"]
+        argv += [a for s in sets for a in ("--set", s)]
+        out = subprocess.run(argv, env=isolated_env(), capture_output=True, text=True, timeout=300)
+        found = re.search(r"real-time factor ([0-9.]+)", out.stderr + out.stdout)
+        assert out.returncode == 0 and found, out.stderr[-2000:]
+        _measured[key] = float(found.group(1))
+    return _measured[key]
+
+
+def require_realtime(
+    groups: Sequence[Sequence[str]], mode: str = "OL", sets: Sequence[str] = ()
+) -> float:
+    """Skip the calling test unless this machine turns this layout over at ``REQUIRED_RTF`` times
+    real time or faster (now, under whatever else runs); returns the figure."""
+    rtf = lockstep_rtf(groups, mode, sets)
+    if rtf < REQUIRED_RTF:
+        layout = " | ".join(", ".join(g) for g in groups) or "four processes"
+        pytest.skip(
+            f"this machine turns the loop ({layout}; {mode}) over at {rtf:.2f}x real time in "
+            f"lockstep, measured now; real time at 1 kHz needs {REQUIRED_RTF:g}x"
+        )
+    return rtf
