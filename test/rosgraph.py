@@ -11,6 +11,7 @@ import os
 import random
 import re
 import signal
+import struct
 import subprocess
 import sys
 import threading
@@ -176,6 +177,29 @@ class Collector:
                 return True
             time.sleep(0.02)
         return self.count(topic) >= n
+
+    def newest_stamp_ns(self, topic: str) -> int | None:
+        """Header stamp (ns) of the last message of a Header-first ``topic`` (little-endian CDR)."""
+        with self._lock:
+            if not self.records[topic]:
+                return None
+            data = self.records[topic][-1][1]
+        sec, nsec = struct.unpack_from("<iI", data, 4)
+        return sec * 1_000_000_000 + nsec
+
+    def wait_for_stamp(self, topic: str, stamp_ns: int, timeout: float) -> bool:
+        """Wait until a message stamped ``stamp_ns`` or later arrived (False on timeout).
+
+        Reliable readers get one writer's messages in order, so the newest tells.
+        """
+        end = time.monotonic() + timeout
+        while True:
+            newest = self.newest_stamp_ns(topic)
+            if newest is not None and newest >= stamp_ns:
+                return True
+            if time.monotonic() >= end:
+                return False
+            time.sleep(0.02)
 
     def messages(self, topic: str) -> list[Any]:
         """The decoded (rosbags) messages of ``topic`` received so far."""

@@ -62,6 +62,27 @@ def test_a_change_is_unknown_before_and_boundaries_merge() -> None:
     assert len(segs) == 1 and segs[0].params["controller_node"] == {"mode": "CL", "kf": 2.0}
 
 
+def test_an_event_stamped_on_the_samples_timeline_splits_at_its_stamp() -> None:
+    """A loop node stamps its event with the first sample it applies to: the split is exact
+    even when the event reached the recorder seconds late (repaired in transit)."""
+    late = ParamEvent(260, "/controller_node", {"mode": "DOB"}, (), frozenset(), 1_000_055)
+    wall = ParamEvent(150, "/environment_node", {"stiffness_n_per_m": 900.0}, (), frozenset(), 17)
+    initial, changes = parameter_history([late, wall], "")
+    recv = np.arange(0, 300, 10)  # sample i received at 10 i, stamped 1_000_000 + 10 i
+    segs = split(recv, initial, changes, start_ns=1_000_000, period_ns=10)
+    # the controller's change at stamp 1_000_055 -> sample 6 (stamped 1_000_060), although
+    # received after sample 25; the environment's stamp (17) is off the timeline: by receipt
+    assert [(s.start, s.stop) for s in segs] == [(0, 6), (6, 15), (15, 30)]
+    assert [s.value("controller_node", "mode") for s in segs] == [None, "DOB", "DOB"]
+    assert segs[2].value("environment_node", "stiffness_n_per_m") == 900.0
+    # without the samples' stamps, both split by receipt (the old behaviour)
+    assert [(s.start, s.stop) for s in split(recv, initial, changes)] == [
+        (0, 15),
+        (15, 26),
+        (26, 30),
+    ]
+
+
 @pytest.mark.parametrize("frames", [("base_link",) * 3, ("a", "base_link", "xyz_long_frame")])
 def test_fast_vector_reader_matches_the_deserializer(frames: tuple[str, ...]) -> None:
     datas = []

@@ -150,3 +150,44 @@ def test_a_live_switch_acts_on_the_next_cycle_in_process(composed) -> None:
     expected = float(np.clip(wall[0] + 1.0 * (wall[0] + measured[0]), -4.0, 4.0))
     assert join.law.mode.value == "CL" and join.sent_ns == k * controller.period_ns
     assert device.device.sample().effort[0] == expected
+
+
+def test_parameter_events_carry_the_sample_a_change_applies_from(composed) -> None:
+    ex, nodes, _sends = composed
+    env, observer, controller, device = nodes
+    from rcl_interfaces.msg import ParameterEvent
+
+    events: list[ParameterEvent] = []
+    listener = rclpy.create_node("event_listener", context=env.context)
+    listener.create_subscription(ParameterEvent, "/parameter_events", events.append, 100)
+    ex.add_node(listener)
+    before = env.get_clock().now().nanoseconds
+    assert env.set_parameters([Parameter("stiffness_n_per_m", value=1000.0)])[0].successful
+    turn(device, 300)
+    k = device.device.k
+    period = controller.period_ns
+    assert controller.set_parameters([Parameter("kf", value=2.0)])[0].successful
+    assert env.set_parameters([Parameter("stiffness_n_per_m", value=1200.0)])[0].successful
+    assert observer.set_parameters([Parameter("gain", value=300.0)])[0].successful
+    assert not env.set_parameters([Parameter("stiffness_n_per_m", value=-1.0)])[0].successful
+    # the node's own clock is untouched: a refused change and the next reading see real time
+    assert env.get_clock().now().nanoseconds >= before
+    end = time.monotonic() + 10
+    while len(events) < 4 and time.monotonic() < end:
+        ex.spin_once(timeout_sec=0.05)
+    ex.remove_node(listener)
+    listener.destroy_node()
+    from rclpy.parameter import parameter_value_to_python
+
+    stamps = {
+        (e.node, p.name, parameter_value_to_python(p.value)): e.stamp.sec * 10**9 + e.stamp.nanosec
+        for e in events
+        for p in e.changed_parameters
+    }
+    # before the loop ran: the node's clock (wall time, not a sample's stamp)
+    assert stamps[("/environment_node", "stiffness_n_per_m", 1000.0)] >= before
+    # the loop ran samples 0..k-1 and sent commands 0..k-1: sample k is the first changed
+    assert stamps[("/controller_node", "kf", 2.0)] == k * period
+    assert stamps[("/environment_node", "stiffness_n_per_m", 1200.0)] == k * period
+    assert stamps[("/observer_node", "gain", 300.0)] == k * period
+    assert len(events) == 4, [(e.node, e.stamp) for e in events]

@@ -243,7 +243,7 @@ def analyze_bag(
     data = read_bag(path, sel)
     rec = build_record(data)
     initial, changes = parameter_history(data.events, data.namespace)
-    segments = split(rec.recv_ns, initial, changes)
+    segments = split(rec.recv_ns, initial, changes, rec.t0_ns, rec.dt_ns)
     for series in (data.motion, data.force, data.velocity):  # the record holds what is needed
         if series is not None:
             series.stamps_ns = series.recv_ns = series.values = np.zeros(0)

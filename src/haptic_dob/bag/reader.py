@@ -71,6 +71,7 @@ class ParamEvent:
     values: dict[str, Any]  # new and changed parameters
     deleted: tuple[str, ...]
     new: frozenset[str]  # the names in new_parameters (declarations, the recorder's snapshot)
+    stamp_ns: int | None = None  # the event's own stamp (loop nodes: the sample it applies from)
 
 
 @dataclass
@@ -306,7 +307,8 @@ def param_event(msg: Any, time_ns: int) -> ParamEvent:
     values.update({p.name: _param_value(p.value) for p in msg.changed_parameters})
     deleted = tuple(p.name for p in msg.deleted_parameters)
     new = frozenset(p.name for p in msg.new_parameters)
-    return ParamEvent(time_ns, str(msg.node), values, deleted, new)
+    stamp = int(msg.stamp.sec) * 1_000_000_000 + int(msg.stamp.nanosec)
+    return ParamEvent(time_ns, str(msg.node), values, deleted, new, stamp)
 
 
 def read_bag(path: str | Path, selection: Selection | None = None) -> BagData:

@@ -10,12 +10,16 @@ Sources, in bag (receive) time order, for the nodes in the motion topic's namesp
 
 Only the parameters that shape the rendering (``RELEVANT``) split the session: the controller's
 mode, kf and force limit, the wall's stiffness, damping, position and normal, the observer's
-gain and output limit. A change splits the samples at the first motion sample the recorder
-received at or after the parameter event (both carry the recorder's receive time; the event's
-own wall-clock stamp is not comparable with the loop's sample stamps, which in lockstep run
-faster than real time). The recorder receives the event and the samples through one executor,
-in the order they arrived, so the split lands within a few samples of the first cycle the node
-computed with the new value.
+gain and output limit. Where a change takes effect:
+
+- an event stamped on the samples' own timeline (within the motion's stamps) splits at that
+  stamp: this suite's loop nodes stamp their events with the first sample the change applies to,
+  so the split is exact however late the event reached the recorder (a reliable message lost in
+  transit is repaired at the writer's next heartbeat, seconds later on a loaded machine); a
+  device stamping its samples with the system clock gives the same with any node's events;
+- otherwise (a wall-clock stamp beside samples stamped from a run's start) at the first motion
+  sample the recorder received at or after the event (both carry the recorder's receive time),
+  within a few samples of the change when the event was not delayed in transit.
 """
 
 from __future__ import annotations
@@ -57,6 +61,7 @@ class Change:
     time_ns: int
     node: str
     values: dict[str, Any]
+    stamp_ns: int | None = None  # the event's own stamp
 
 
 @dataclass
@@ -101,21 +106,45 @@ def parameter_history(events: list[ParamEvent], namespace: str) -> tuple[Params,
                 diff[k] = v
         if diff:
             known.update(diff)
-            changes.append(Change(ev.time_ns, base, diff))
+            changes.append(Change(ev.time_ns, base, diff, ev.stamp_ns))
     return initial, changes
 
 
-def split(recv_ns: np.ndarray, initial: Params, changes: list[Change]) -> list[Segment]:
-    """Cut samples (their non-decreasing receive times ``recv_ns``) into segments at changes.
+def split(
+    recv_ns: np.ndarray,
+    initial: Params,
+    changes: list[Change],
+    start_ns: int | None = None,
+    period_ns: int | None = None,
+) -> list[Segment]:
+    """Cut samples into segments at changes.
 
-    A change takes effect at the first sample received at or after it; several changes landing
-    on the same sample make one boundary; changes after the last sample are ignored.
+    Sample ``i`` is stamped ``start_ns + i * period_ns`` (when given) and was received at
+    ``recv_ns[i]`` (non-decreasing). A change stamped within the samples' stamps takes effect at
+    the first sample stamped at or after it, any other at the first sample received at or after
+    it; several changes landing on the same sample make one boundary; changes after the last
+    sample are ignored.
     """
     n = int(recv_ns.size)
+    at: list[tuple[int, Change]] = []
+    last_ns = None if start_ns is None or not period_ns else start_ns + (n - 1) * period_ns
+    for ch in changes:
+        stamp = ch.stamp_ns
+        if (
+            stamp is not None
+            and start_ns is not None
+            and period_ns
+            and last_ns is not None
+            and (start_ns <= stamp <= last_ns)
+        ):
+            i = -(-(stamp - start_ns) // period_ns)  # the first sample stamped at or after it
+        else:
+            i = int(np.searchsorted(recv_ns, ch.time_ns, side="left"))
+        at.append((i, ch))
+    at.sort(key=lambda item: item[0])  # stable: changes on one sample keep their order
     current = copy.deepcopy(initial)
     segs = [Segment(0, 0, n, copy.deepcopy(current))]
-    for ch in changes:
-        i = int(np.searchsorted(recv_ns, ch.time_ns, side="left"))
+    for i, ch in at:
         if i >= n:
             break
         current.setdefault(ch.node, {}).update(ch.values)

@@ -137,6 +137,11 @@ class ControllerNode(LoopNode):
         return self.join.controller
 
     # --- parameters ------------------------------------------------------------------------
+    def next_sample_ns(self) -> int | None:
+        """The command after the newest sent is the first computed with a new law."""
+        join = getattr(self, "join", None)
+        return None if join is None or join.sent_ns < 0 else join.sent_ns + self.period_ns
+
     def _settings(self, values: Mapping[str, Any]) -> ImpedanceLaw:
         law = build(ImpedanceLaw, values)
         if hasattr(self, "join"):  # a change at run time, not the start-up values

@@ -36,6 +36,8 @@ class EnvironmentNode(LoopNode):
         self.wall: VirtualWall = self.params.settings
         self._pose: StampedVector | None = None
         self._twist: StampedVector | None = None
+        self._period_ns = round(1e9 / self.params.values["rate_hz"])
+        self._emitted_ns = -1  # stamp of the newest wall force
         self._pub = LoopPublisher(
             self, WRENCH_DESIRED, codecs.WRENCH, qos.LOOP, self.params.values["base_frame"]
         )
@@ -54,6 +56,11 @@ class EnvironmentNode(LoopNode):
         if self.diagnostics.rate_hz == 0.0:
             return WARN, "no ee_pose/ee_twist pairs in the last second", values
         return OK, "rendering", values
+
+    def next_sample_ns(self) -> int | None:
+        """The pose after the newest rendered is the first rendered with a changed wall."""
+        last = getattr(self, "_emitted_ns", -1)
+        return None if last < 0 else last + self._period_ns
 
     @staticmethod
     def _settings(values: Mapping[str, Any]) -> VirtualWall:
@@ -76,6 +83,7 @@ class EnvironmentNode(LoopNode):
             self._emit(pose, twist)
 
     def _emit(self, pose: StampedVector, twist: StampedVector) -> None:
+        self._emitted_ns = pose.stamp_ns
         self._pub.publish(
             StampedVector(pose.stamp_ns, wall_force(self.wall, pose.vector, twist.vector))
         )

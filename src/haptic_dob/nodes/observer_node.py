@@ -122,6 +122,11 @@ class ObserverNode(LoopNode):
             return WARN, "no joint_states in the last second", values
         return OK, "estimating", values
 
+    def next_sample_ns(self) -> int | None:
+        """The sample after the newest estimated is the first with a new gain."""
+        last = getattr(self, "_last_ns", -1)
+        return None if last < 0 else last + self.period_ns
+
     def drain_marker(self) -> int:
         """The newest sample handled: at a stop, the samples still queued are answered first."""
         return self._last_ns

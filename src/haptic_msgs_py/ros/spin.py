@@ -22,14 +22,18 @@ import signal
 import sys
 import time
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import rclpy
+from rcl_interfaces.msg import SetParametersResult
 from rclpy._rclpy_pybind11 import RCLError
 from rclpy.context import Context
 from rclpy.exceptions import InvalidParameterValueException, ParameterException
 from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
+from rclpy.time import Time
 
 from haptic_msgs_py.bus import bus_for
 from haptic_msgs_py.cpu_latency import NO_REQUEST, hold, strictest
@@ -44,11 +48,51 @@ WORK_OFF_S = 0.5  # ... or after this long
 SOON_SLICE_S = 0.004
 
 
+class _LoopTimeOnce:
+    """Stands in for a node's clock for one ``now()``: the loop's stamp, then the real clock."""
+
+    def __init__(self, node: Node, real: Any, stamp_ns: int) -> None:
+        self.node, self.real, self.stamp_ns = node, real, stamp_ns
+
+    def now(self) -> Time:
+        self.node._clock = self.real
+        return Time(nanoseconds=self.stamp_ns, clock_type=self.real.clock_type)
+
+
 class LoopNode(Node):
-    """A node the spin loop can wake at a time, tell to shut down, and ask whether it is done."""
+    """A node the spin loop can wake at a time, tell to shut down, and ask whether it is done.
+
+    Its parameter events are stamped on the loop's timeline: with the stamp of the first sample
+    the change applies to (``next_sample_ns``), once the loop runs. A session's analysis then
+    splits at that sample however late the event reaches a recorder (a reliable sample lost in
+    transit is repaired at the writer's next heartbeat, seconds later). Before the first sample
+    the stamp is the node's clock, as for any node.
+    """
 
     finished: bool = False
     exit_code: int = 0
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        # registered before the node's own parameter callbacks, so it runs after them (rclpy
+        # calls the newest first and stops at a refusal): only an accepted change is restamped
+        self.add_on_set_parameters_callback(self._stamp_on_loop_time)
+        self.add_post_set_parameters_callback(self._clock_back)
+
+    def next_sample_ns(self) -> int | None:
+        """Stamp (ns) of the first sample a parameter change made now applies to (None: the
+        loop has not run yet)."""
+        return None
+
+    def _stamp_on_loop_time(self, params: list[Parameter]) -> SetParametersResult:
+        stamp = self.next_sample_ns()
+        if stamp is not None and not any(p.name == "use_sim_time" for p in params):
+            self._clock = _LoopTimeOnce(self, self._clock, stamp)  # type: ignore[assignment]
+        return SetParametersResult(successful=True)
+
+    def _clock_back(self, _params: list[Parameter]) -> None:
+        if isinstance(self._clock, _LoopTimeOnce):
+            self._clock = self._clock.real
 
     def next_wakeup(self) -> float | None:
         """Monotonic time (s) at which ``on_wakeup`` should run, or None."""
