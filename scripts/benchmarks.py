@@ -231,9 +231,10 @@ GRAPH_ARGS: list[str] = []
 
 
 def graph_args(extra: list[str]) -> list[str]:
-    """A benchmark's arguments and ``GRAPH_ARGS``; one process (``--composed``) is not pinned."""
+    """A benchmark's arguments and ``GRAPH_ARGS``; ``--pin`` only where every node has a process
+    of its own (``--processes``): haptic-launch refuses it for nodes sharing a process."""
     args = [*extra, *GRAPH_ARGS]
-    return [a for a in args if a != "--pin"] if "--composed" in args else args
+    return args if "--processes" in args else [a for a in args if a != "--pin"]
 
 
 def _lockstep(repeat: int, extra: list[str]) -> str:
@@ -251,13 +252,19 @@ def _lockstep(repeat: int, extra: list[str]) -> str:
 
 
 def bench_lockstep(repeat: int) -> str:
-    """The 4-process lockstep graph at 1 kHz, 20 s simulated: real-time factor."""
+    """The lockstep graph at 1 kHz, 20 s simulated, as haptic-launch lays it out by default
+    (the loop's four nodes in one process): real-time factor."""
     return _lockstep(repeat, [])
 
 
 def bench_lockstep_composed(repeat: int) -> str:
-    """The same graph composed in one process under one executor."""
+    """The same graph, every node in one process (``--composed``)."""
     return _lockstep(repeat, ["--composed"])
+
+
+def bench_lockstep_processes(repeat: int) -> str:
+    """The same graph, every node in a process of its own (``--processes``)."""
+    return _lockstep(repeat, ["--processes"])
 
 
 def _realtime(repeat: int, extra: list[str]) -> str:
@@ -293,13 +300,19 @@ def _realtime(repeat: int, extra: list[str]) -> str:
 
 
 def bench_realtime(repeat: int) -> str:
-    """The 4-process graph in real time at 1 kHz for 20 s: on-time share and latency."""
+    """The graph in real time at 1 kHz for 20 s, laid out by default (the loop in one
+    process): on-time share and latency."""
     return _realtime(repeat, [])
 
 
 def bench_realtime_composed(repeat: int) -> str:
-    """The same, composed in one process."""
+    """The same, every node in one process (``--composed``)."""
     return _realtime(repeat, ["--composed"])
+
+
+def bench_realtime_processes(repeat: int) -> str:
+    """The same, every node in a process of its own (``--processes``)."""
+    return _realtime(repeat, ["--processes"])
 
 
 FLOOR_S = 20.0  # length of one timer-floor run (s), as the real-time graph runs
@@ -399,8 +412,10 @@ BENCHMARKS: dict[str, Callable[[int], str]] = {
     "observer": bench_observer_update,
     "lockstep": bench_lockstep,
     "lockstep-composed": bench_lockstep_composed,
+    "lockstep-processes": bench_lockstep_processes,
     "realtime": bench_realtime,
     "realtime-composed": bench_realtime_composed,
+    "realtime-processes": bench_realtime_processes,
     "timer-floor": bench_timer_floor,
     "hop": bench_hop,
     "margin": bench_margin,

@@ -1,11 +1,13 @@
-"""Soak benchmark: the 4-process slide graph in real time for a long while; memory and deadlines.
+"""Soak benchmark: the slide graph in real time for a long while; memory and deadlines.
 
-Starts ``haptic-launch slide_sim`` in real-time mode on a fresh domain (localhost discovery) for
+Starts ``haptic-launch slide_sim [LAUNCH_ARG ...]`` (by default the loop in one process)
+in real-time mode on a fresh domain (localhost discovery) for
 ``--minutes`` of wall time, samples the resident memory (``VmRSS``) of every node process once a
 ``--every`` seconds, and at the end reads the device's cycle statistics (``stats_file``). Memory
 growth is measured from the first sample after ``--warmup`` seconds to the end, per process.
 
     .venv/bin/python scripts/soak.py --minutes 30
+    .venv/bin/python scripts/soak.py --minutes 30 -- --processes --set controller_node:mode=DOB
 """
 
 from __future__ import annotations
@@ -34,7 +36,14 @@ def children(pid: int) -> dict[int, str]:
             continue
         if int(fields.get("PPid", "0").strip()) == pid:
             cmdline = (status.parent / "cmdline").read_bytes().split(b"\0")
-            name = next((Path(a.decode()).name for a in cmdline if b"node" in a), "?")
+            name = next(
+                (
+                    Path(a.decode()).name
+                    for a in cmdline
+                    if b"node" in a or a.endswith(b"container")
+                ),
+                "?",
+            )
             out[int(status.parent.name)] = name
     return out
 
@@ -56,6 +65,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--minutes", type=float, default=30.0, help="wall time (default 30)")
     p.add_argument("--warmup", type=float, default=60.0, help="s before the memory baseline")
     p.add_argument("--every", type=float, default=10.0, help="s between memory samples")
+    p.add_argument(
+        "launch_args", nargs="*", metavar="LAUNCH_ARG", help="more haptic-launch arguments"
+    )
     a = p.parse_args(argv)
     duration = a.minutes * 60.0
     with tempfile.TemporaryDirectory() as tmp:
@@ -66,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
             ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
         )
         launcher = os.path.join(os.path.dirname(sys.executable), "haptic-launch")
-        argv_launch = [launcher, "slide_sim"]
+        argv_launch = [launcher, "slide_sim", *a.launch_args]
         for item in (
             "device_node:clock_mode=realtime",
             "device_node:duration_s=0.0",

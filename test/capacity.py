@@ -25,6 +25,7 @@ BIN = Path(sys.executable).parent
 #: loaded machine (the device's watchdog zeroes the force after five late periods)
 REQUIRED_RTF = 1.2
 MEASURE_S = 2.0  # simulated seconds of the lockstep measurement
+PROBE_TIMEOUT_S = 200  # wall seconds the probe may take (the tests' own timeout is 300 s)
 
 _measured: dict[tuple[tuple[str, ...], ...], float] = {}
 
@@ -42,9 +43,19 @@ def lockstep_rtf(
         argv += ["--set", f"device_node:duration_s={MEASURE_S}"]
         argv += ["--set", f"controller_node:mode={mode}", "--set", "controller_node:kf=1.0"]
         argv += [a for s in sets for a in ("--set", s)]
-        out = subprocess.run(argv, env=isolated_env(), capture_output=True, text=True, timeout=300)
-        found = re.search(r"real-time factor ([0-9.]+)", out.stderr + out.stdout)
-        assert out.returncode == 0 and found, out.stderr[-2000:]
+        # inside the test's own timeout, so a stuck probe says what it printed; SIGTERM lets
+        # haptic-launch stop the nodes it started (a SIGKILL would orphan them)
+        proc = subprocess.Popen(
+            argv, env=isolated_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        try:
+            stdout, stderr = proc.communicate(timeout=PROBE_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            proc.terminate()
+            stdout, stderr = proc.communicate(timeout=60)
+            pytest.fail(f"the capacity probe ran over {PROBE_TIMEOUT_S} s:\n{stderr[-2000:]}")
+        found = re.search(r"real-time factor ([0-9.]+)", stderr + stdout)
+        assert proc.returncode == 0 and found, stderr[-2000:]
         _measured[key] = float(found.group(1))
     return _measured[key]
 
