@@ -163,7 +163,9 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
                 shown = max(shown, after_cmd)
         latency = stamps[first_zero] - stamps[shown]
         assert latency <= TIMEOUT_S + 2 * PERIOD_S + 1e-9, f"{latency * 1e3:.1f} ms"
-        deadline = time.monotonic() + 5  # diagnostics come once a second
+        # diagnostics come once a second; on one loaded core the collector may take a while to
+        # see them (a guard against hanging, not a bound on the node)
+        deadline = time.monotonic() + 30
         while time.monotonic() < deadline:
             statuses = diagnostics_after(col, t_kill)
             if any(reason in s for s in statuses):
