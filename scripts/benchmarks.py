@@ -13,7 +13,11 @@ import statistics
 import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_pattern import pattern_cycle_us
 
 
 def machine() -> str:
@@ -179,30 +183,49 @@ def bench_margin(repeat: int) -> str:
     """The loop's cost against its floors, in DOB mode, each ratio taken within one run:
 
     - composed lockstep cycle / batch cycle (batch measured just before and after the graph);
-    - 4-process lockstep cycle / (3 raw hops + batch cycle), hops measured before and after.
+    - 4-process lockstep cycle / (3 raw hops + batch cycle), hops measured before and after;
+    - 4-process lockstep cycle / (the loop's message pattern + batch cycle): what the nodes add
+      to what DDS costs for the messages a cycle passes (``bench_pattern``).
     """
-    composed, processes = [], []
+    composed, processes, nodes = [], [], []
     rows = []
     for _ in range(repeat):
         b1 = batch_cycle_us()
         c = _lockstep_cycle_us(["--composed", *MARGIN_MODE])
         b2 = batch_cycle_us()
         h1 = hop_us()
+        m1 = pattern_cycle_us()
         p = _lockstep_cycle_us(["--processes", *MARGIN_MODE])
+        m2 = pattern_cycle_us()
         h2 = hop_us()
         b3 = batch_cycle_us()
         composed.append(c / ((b1 + b2) / 2))
         floor = 3 * (h1 + h2) / 2 + (b2 + b3) / 2
         processes.append(p / floor)
+        pattern = (m1 + m2) / 2 + (b2 + b3) / 2
+        nodes.append(p / pattern)
         rows.append(
             f"batch {b1:.0f}/{b2:.0f}/{b3:.0f} us, composed {c:.0f} us, hop {h1:.0f}/{h2:.0f} "
-            f"us, 4 processes {p:.0f} us (floor {floor:.0f})"
+            f"us, pattern {m1:.0f}/{m2:.0f} us, 4 processes {p:.0f} us (hop floor {floor:.0f}, "
+            f"pattern floor {pattern:.0f})"
         )
+
+    def ratios(xs: list[float]) -> str:
+        return f"median {statistics.median(xs):.2f} (runs: {', '.join(f'{r:.2f}' for r in xs)})"
+
     return (
-        f"composed / batch cycle: median {statistics.median(composed):.2f} (runs: "
-        f"{', '.join(f'{r:.2f}' for r in composed)}); 4 processes / (3 hops + batch): median "
-        f"{statistics.median(processes):.2f} (runs: {', '.join(f'{r:.2f}' for r in processes)})"
-        f"; {'; '.join(rows)}"
+        f"composed / batch cycle: {ratios(composed)}; 4 processes / (3 hops + batch): "
+        f"{ratios(processes)}; 4 processes / (message pattern + batch): {ratios(nodes)}; "
+        f"{'; '.join(rows)}"
+    )
+
+
+def bench_pattern(repeat: int) -> str:
+    """The loop's message pattern between four processes that do nothing else (µs a cycle)."""
+    cycles = [pattern_cycle_us() for _ in range(repeat)]
+    return (
+        f"cycle median {statistics.median(cycles):.0f} us (runs: "
+        f"{', '.join(f'{c:.0f}' for c in cycles)})"
     )
 
 
@@ -418,6 +441,7 @@ BENCHMARKS: dict[str, Callable[[int], str]] = {
     "realtime-processes": bench_realtime_processes,
     "timer-floor": bench_timer_floor,
     "hop": bench_hop,
+    "pattern": bench_pattern,
     "margin": bench_margin,
 }
 

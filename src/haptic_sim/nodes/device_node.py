@@ -236,9 +236,12 @@ class DeviceNode(LoopNode):
 
     # --- publishing ------------------------------------------------------------------------
     def _publish(self, s: DeviceSample) -> None:
-        """Sample k to every topic: nodes in this process get it at once, depth first, in the
-        order that closes the loop soonest (the wall's inputs, the sensor, then the joints);
-        readers in other processes get it once the whole sample is out (``Bus.batch``)."""
+        """Sample k to every topic, in the order that closes the loop soonest: the wall's inputs
+        first. Nodes in this process get it at once, depth first: the sensor before the joints,
+        so that in CL the command is out before the observer works. A device alone in its
+        process sends the joints before the sensor: each DDS send costs tens of microseconds
+        and in DOB (the suite's subject) the observer's joints are on the command's path.
+        Readers in other processes get the sample once it is all out (``Bus.batch``)."""
         self._sent_s = time.monotonic()
         k = s.stamp_ns
         bus = self._bus
@@ -246,8 +249,12 @@ class DeviceNode(LoopNode):
         try:
             self._p_pose.publish(StampedVector(k, s.ee_position))
             self._p_twist.publish(StampedVector(k, s.ee_velocity))
-            self._p_measured.publish(StampedVector(k, s.wrench_measured))
+            measured = StampedVector(k, s.wrench_measured)
+            if bus.composed:
+                self._p_measured.publish(measured)
             self._p_js.publish(JointSample(k, self._names, s.q, s.qd, s.effort))
+            if not bus.composed:
+                self._p_measured.publish(measured)
             # evaluation-only topics: built only when someone takes them
             if self._p_hand.wanted:
                 self._p_hand.publish(StampedVector(k, s.hand_force))

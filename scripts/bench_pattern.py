@@ -1,0 +1,113 @@
+"""The DDS floor of the loop's message pattern: four processes that only pass messages.
+
+Four rclpy processes (events executor, raw bytes of a small message, the loop's QoS) pass the
+messages a slide DOB cycle passes between ``--processes`` nodes, and nothing else: the device
+sends pose, twist, joint states and the sensor's wrench; the environment answers pose + twist
+with one message, the observer answers the joint states with one; the controller answers wall +
+estimate with the command, which releases the device's next sample, and takes the sensor's
+wrench as well (it uses it in CL). The cycle of this graph is
+what DDS and rclpy cost for the pattern with no maths and no node logic: the 4-process lockstep
+cycle compared with (this + the batch cycle) is what the nodes add. Used by
+``benchmarks.py pattern`` and ``margin``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import multiprocessing
+import os
+import random
+import statistics
+import time
+from typing import Any
+
+#: role -> (topics it publishes, topics it waits for before answering)
+ROLES: dict[str, tuple[list[str], list[str]]] = {
+    "device": (["pose", "twist", "joint_states", "wrench_measured"], ["effort_command"]),
+    "environment": (["wrench_wall"], ["pose", "twist"]),
+    "observer": (["wrench_estimate"], ["joint_states"]),
+    "controller": (["effort_command"], ["wrench_wall", "wrench_estimate"]),
+}
+
+
+def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
+    """One process of the pattern; the device times ``cycles`` cycles and puts the median."""
+    os.environ["ROS_DOMAIN_ID"] = domain
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.experimental import EventsExecutor
+    from std_msgs.msg import Header
+
+    from haptic_msgs_py import wire
+    from haptic_msgs_py.ros.qos import ESTIMATOR_IN, LOOP, LOOP_IN
+
+    ctx = Context()
+    rclpy.init(context=ctx, args=[])
+    node = rclpy.create_node(f"pattern_{role}", context=ctx)
+    ex = EventsExecutor(context=ctx)
+    data = wire.encode(wire.header("base_link"))
+    sends, waits = ROLES[role]
+    pubs = [node.create_publisher(Header, t, LOOP) for t in sends]
+    got: set[str] = set()
+    ends: list[float] = []
+
+    def answer() -> None:
+        for p in pubs:
+            p.publish(data)
+
+    def on(topic: str) -> Any:
+        def callback(_msg: bytes) -> None:
+            got.add(topic)
+            if len(got) == len(waits):
+                got.clear()
+                if role == "device":
+                    ends.append(time.perf_counter())
+                    if len(ends) >= cycles:
+                        return
+                answer()
+
+        return callback
+
+    for t in waits:
+        qos = ESTIMATOR_IN if role == "observer" else LOOP_IN
+        node.create_subscription(Header, t, on(t), qos, raw=True)
+    if role == "controller":  # taken, not waited for
+        node.create_subscription(Header, "wrench_measured", lambda _m: None, LOOP_IN, raw=True)
+    ex.add_node(node)
+    settle = time.monotonic() + 5.0  # discovery and matching of every endpoint
+    while time.monotonic() < settle:
+        ex.spin_once(timeout_sec=0.01)
+    if role != "device":
+        while not stop.is_set() and ctx.ok():
+            ex.spin_once(timeout_sec=0.05)
+        return
+    answer()
+    limit = time.monotonic() + 60.0 + cycles * 0.01
+    while len(ends) < cycles and time.monotonic() < limit:
+        ex.spin_once(timeout_sec=0.1)
+    steps = [b - a for a, b in itertools.pairwise(ends)][cycles // 10 :]
+    out.put(statistics.median(steps) * 1e6 if steps else None)
+
+
+def pattern_cycle_us(cycles: int = 5000) -> float:
+    """Median cycle (µs) of the loop's message pattern between four processes (first 10 %
+    left out as warm-up)."""
+    ctx = multiprocessing.get_context("spawn")
+    out, stop = ctx.Queue(), ctx.Event()
+    domain = str(random.randint(101, 200))
+    procs = [ctx.Process(target=_peer, args=(r, cycles, domain, stop, out)) for r in ROLES]
+    for p in procs:
+        p.start()
+    try:
+        cycle = out.get(timeout=120.0 + cycles * 0.01)
+    finally:
+        stop.set()
+        for p in procs:
+            p.join(10)
+            if p.is_alive():
+                p.terminate()
+                p.join(5)
+    if cycle is None:
+        raise RuntimeError("the message pattern did not turn over")
+    return float(cycle)
