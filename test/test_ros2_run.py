@@ -75,3 +75,29 @@ def test_executable_resolves_starts_and_stops_on_sigint(package: str, name: str)
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait(5)
+
+
+@pytest.mark.parametrize("delay_s", [0.0, 0.3, 1.0, 2.5])
+@pytest.mark.parametrize(
+    ("package", "name"),
+    [("haptic_sim", "device_node"), ("haptic_dob", "controller_node")],
+    ids=["device_node", "controller_node"],
+)
+def test_ctrl_c_during_start_up_ends_quietly(package: str, name: str, delay_s: float) -> None:
+    """``ros2 launch`` or a terminal sends SIGINT while the node still imports or starts: it
+    ends with 0 (node up), 130 (still importing) or by the signal itself (before Python ran),
+    never with a traceback."""
+    exe = Path(get_package_prefix(package)) / "lib" / package / name
+    proc = subprocess.Popen(
+        [str(exe)], env=isolated_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT
+    )
+    try:
+        time.sleep(delay_s)
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=30)
+        assert b"Traceback" not in out and b"KeyboardInterrupt" not in out, out.decode()
+        assert proc.returncode in (0, 130, -signal.SIGINT), (proc.returncode, out.decode())
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(5)

@@ -32,6 +32,17 @@ class ParamSpec:
     choices: tuple[str, ...] = ()
     read_only: bool = False
     length: int | None = None  # arrays: the required number of elements, None = any
+    items: type | None = None  # arrays: element type (float, int, str); None = the default's
+
+    @property
+    def item_kind(self) -> type | None:
+        """Element type of an array (float when the default is empty), None for scalars."""
+        if self.kind is not list:
+            return None
+        if self.items is not None:
+            return self.items
+        d = list(self.default)  # type: ignore[arg-type]  # kind is list
+        return type(d[0]) if d else float
 
     @property
     def kind(self) -> type:
@@ -75,12 +86,15 @@ class ParamSpec:
         if isinstance(value, (str, bytes)) or not hasattr(value, "__len__"):
             return f"{self.name} must be an array, got {value!r}"
         items = list(value)
-        default = list(self.default)  # type: ignore[arg-type]
         if self.length is not None and len(items) != self.length:
             return f"{self.name} must have {self.length} elements, got {len(items)}"
-        if default and isinstance(default[0], str):
+        if self.item_kind is str:
             if not all(isinstance(v, str) for v in items):
                 return f"{self.name} must be an array of strings"
+            return None
+        if self.item_kind is int:
+            if not all(isinstance(v, int) and not isinstance(v, bool) for v in items):
+                return f"{self.name} must be an array of integers, got {items!r}"
             return None
         for v in items:
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):

@@ -40,4 +40,3 @@ SESSION_TOPICS: dict[str, str] = {
 }
 
 DEFAULT_BASE_FRAME = "base_link"
-DEFAULT_EE_FRAME = "ee_link"

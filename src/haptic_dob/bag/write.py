@@ -90,7 +90,7 @@ def vector_template(typename: str, frame: str = "base_link") -> Template:
     return Template(msg, 3)
 
 
-def joint_template(name: str = "slide", frame: str = "ee_link") -> Template:
+def joint_template(name: str = "slide", frame: str = "base_link") -> Template:
     """JointState of one joint: position, velocity, effort patched."""
     msg = wire.joint_state([name], frame)
     m = _marks(3)

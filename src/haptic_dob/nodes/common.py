@@ -3,19 +3,18 @@
 from __future__ import annotations
 
 from haptic_msgs_py.params import ParamSpec
-from haptic_msgs_py.topics import DEFAULT_BASE_FRAME, DEFAULT_EE_FRAME
+from haptic_msgs_py.topics import DEFAULT_BASE_FRAME
 
 CLOCK_MODES = ("lockstep", "realtime")
 
 
 def loop_specs() -> list[ParamSpec]:
-    """``rate_hz`` and the frames: the same on every node of a session (YAML ``/**``)."""
+    """``rate_hz`` and the base frame: the same on every node of a session (YAML ``/**``)."""
     return [
         ParamSpec("rate_hz", 1000.0, "control rate of the loop", "Hz", 1.0, 1e5, read_only=True),
         ParamSpec(
             "base_frame", DEFAULT_BASE_FRAME, "frame of poses, twists and wrenches", read_only=True
         ),
-        ParamSpec("ee_frame", DEFAULT_EE_FRAME, "frame name of the end effector", read_only=True),
     ]
 
 
@@ -28,6 +27,7 @@ def process_specs() -> list[ParamSpec]:
             "CPUs this node's process runs on, every thread (as ros2_control's cpu_affinity); "
             "[] = wherever the system schedules it. haptic-launch --pin fills it per node",
             read_only=True,
+            items=int,
         ),
         ParamSpec(
             "cpu_latency_us",

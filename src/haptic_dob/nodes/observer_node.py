@@ -99,7 +99,12 @@ class ObserverNode(LoopNode):
             self, WRENCH_ESTIMATE, codecs.WRENCH, qos.LOOP, values["base_frame"]
         )
         self._pub_effort = LoopPublisher(  # for evaluation: sent only while someone reads it
-            self, EFFORT_ESTIMATE, codecs.JOINT_STATE, qos.LOOP, values["ee_frame"], on_demand=True
+            self,
+            EFFORT_ESTIMATE,
+            codecs.JOINT_STATE,
+            qos.LOOP,
+            values["base_frame"],
+            on_demand=True,
         )
         LoopSubscription(
             self, JOINT_STATES, codecs.JOINT_STATE, self._on_joint_states, qos.ESTIMATOR_IN

@@ -24,13 +24,27 @@ from rclpy.parameter import Parameter
 from haptic_msgs_py.params import ParamSpec
 
 
+def ros_type(spec: ParamSpec) -> Parameter.Type:
+    """The ROS parameter type a spec is declared with (arrays by their element type)."""
+    if spec.kind is list:
+        return {str: Parameter.Type.STRING_ARRAY, int: Parameter.Type.INTEGER_ARRAY}.get(
+            spec.item_kind, Parameter.Type.DOUBLE_ARRAY
+        )
+    return {
+        bool: Parameter.Type.BOOL,
+        int: Parameter.Type.INTEGER,
+        str: Parameter.Type.STRING,
+    }.get(spec.kind, Parameter.Type.DOUBLE)
+
+
 def descriptor(spec: ParamSpec) -> ParameterDescriptor:
-    """The ``ParameterDescriptor`` of a spec (dynamic typing: 2 and 2.0 are both accepted)."""
+    """The ``ParameterDescriptor`` of a spec: its type fixed (``ros2 param describe`` shows it
+    whatever is set later), description with unit, range, choices, read-only."""
     d = ParameterDescriptor(
         name=spec.name,
+        type=ros_type(spec).value,
         description=spec.full_description(),
         read_only=spec.read_only,
-        dynamic_typing=True,
     )
     if spec.choices:
         d.additional_constraints = "one of: " + ", ".join(spec.choices)
@@ -45,8 +59,10 @@ def descriptor(spec: ParamSpec) -> ParameterDescriptor:
 
 def unset_as_empty(spec: ParamSpec, value: Any) -> Any:
     """An array given as ``[]`` (YAML or ``-p name:=[]``) reaches rclpy untyped, as "not set"
-    (None): for an array parameter that is the empty list."""
-    return [] if value is None and spec.kind is list else value
+    (None) or as an empty byte array: for an array parameter that is the empty list."""
+    if spec.kind is list and (value is None or (hasattr(value, "__len__") and not len(value))):
+        return []
+    return value
 
 
 def normalise(spec: ParamSpec, value: Any) -> Any:
@@ -54,9 +70,28 @@ def normalise(spec: ParamSpec, value: Any) -> Any:
     value = unset_as_empty(spec, value)
     if spec.kind is float and isinstance(value, int) and not isinstance(value, bool):
         return float(value)
-    if spec.kind is list:
+    if spec.kind is list and spec.item_kind is float:
         return [float(v) if isinstance(v, int) and not isinstance(v, bool) else v for v in value]
+    if spec.kind is list:
+        return list(value)
     return value
+
+
+def typed(spec: ParamSpec, param: Parameter) -> Parameter:
+    """``param`` as the spec's declared type when it converts without loss (an integer for a
+    double, integers for doubles, ``[]`` for any array), as rclcpp converts ``-p kf:=25`` for a
+    double; anything else unchanged (rclpy then refuses the wrong type and keeps the value)."""
+    want = ros_type(spec)
+    if param.type_ == want:
+        return param
+    value = unset_as_empty(spec, param.value)
+    if spec.kind is list and not value:
+        return Parameter(param.name, want, [])
+    if want is Parameter.Type.DOUBLE and param.type_ is Parameter.Type.INTEGER:
+        return Parameter(param.name, want, float(value))
+    if want is Parameter.Type.DOUBLE_ARRAY and param.type_ is Parameter.Type.INTEGER_ARRAY:
+        return Parameter(param.name, want, [float(v) for v in value])
+    return param
 
 
 class ParameterTable:
@@ -84,13 +119,36 @@ class ParameterTable:
         self._pending: Any = None
         self._declaring = True
         self.values: dict[str, Any] = {}
+        node.add_pre_set_parameters_callback(self._typed)
         node.add_on_set_parameters_callback(self._on_set)
         node.add_post_set_parameters_callback(self._post_set)
+        # values given at start-up (params file, -p) are converted like later sets are; rclpy
+        # cannot declare an empty typed array (it re-reads [] as a byte array): such a
+        # parameter is declared by its default or type and set empty right after
+        overrides = getattr(node, "_parameter_overrides", {})
+        empty = []
+        for name, spec in self.specs.items():
+            if name in overrides:
+                given = typed(spec, overrides[name])
+                if spec.kind is list and given.type_ is ros_type(spec) and not given.value:
+                    del overrides[name]
+                    empty.append(name)
+                else:
+                    overrides[name] = given
         declared = node.declare_parameters(
             "", [(s.name, _ros_default(s), descriptor(s)) for s in self.specs.values()]
         )
+        # (read-only lifted for that set: describe_parameter hands out the node's descriptor)
         for p in declared:
-            self.values[p.name] = normalise(self.specs[p.name], p.value)
+            if p.type_ is Parameter.Type.NOT_SET or p.name in empty:
+                d = node.describe_parameter(p.name)
+                read_only, d.read_only = d.read_only, False
+                try:
+                    node.set_parameters([Parameter(p.name, ros_type(self.specs[p.name]), [])])
+                finally:
+                    d.read_only = read_only
+        for name in self.specs:
+            self.values[name] = normalise(self.specs[name], node.get_parameter(name).value)
         self._declaring = False
         self.settings = validate(self.values) if validate else None
 
@@ -104,6 +162,10 @@ class ParameterTable:
         self._validate, self._apply = validate, apply
         self.settings = validate(self.values)
         return self.settings
+
+    def _typed(self, params: list[Parameter]) -> list[Parameter]:
+        """Pre-set: values of another type that convert without loss take the declared type."""
+        return [typed(self.specs[p.name], p) if p.name in self.specs else p for p in params]
 
     def _on_set(self, params: list[Parameter]) -> SetParametersResult:
         proposed = dict(self.values)
@@ -139,8 +201,8 @@ class ParameterTable:
             self._apply(self.settings)
 
 
-def _ros_default(spec: ParamSpec) -> Any:
-    """Default in a form rclpy accepts for declaration (typed arrays need a homogeneous list)."""
+def _ros_default(spec: ParamSpec) -> Parameter.Type | Any:
+    """Default in a form rclpy accepts for declaration: an empty array by its type."""
     if spec.kind is list:
-        return list(spec.default)  # type: ignore[arg-type]
+        return list(spec.default) or ros_type(spec)  # type: ignore[arg-type]  # kind is list
     return spec.default

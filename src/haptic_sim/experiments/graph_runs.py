@@ -90,7 +90,7 @@ def params_digest(run: GraphRun) -> str:
 def _params_yaml(run: GraphRun, bag: Path) -> str:
     params = {k: dict(v) for k, v in run.params.items()}
     add_recorder(params, str(bag), "mcap")
-    doc = {"/**" if k == "/**" else k: {"ros__parameters": v} for k, v in params.items()}
+    doc = {"/**" if k == "/**" else f"/**/{k}": {"ros__parameters": v} for k, v in params.items()}
     return yaml.safe_dump(doc, sort_keys=False)
 
 

@@ -155,7 +155,7 @@ class DeviceNode(LoopNode):
         self.lockstep = v["clock_mode"] == "lockstep"
         cycles = round(v["duration_s"] * v["rate_hz"])
         self.last_k = cycles if cycles > 0 else None  # the run ends after publishing sample N
-        base, ee = v["base_frame"], v["ee_frame"]
+        base = v["base_frame"]
         self._names = tuple(self.device.model.joint_names)
 
         def pub(topic: str, codec: codecs.Codec, frame: str) -> LoopPublisher:
@@ -165,7 +165,7 @@ class DeviceNode(LoopNode):
             pub(EE_POSE, codecs.POSE, base),
             pub(EE_TWIST, codecs.TWIST, base),
         )
-        self._p_js = pub(JOINT_STATES, codecs.JOINT_STATE, ee)
+        self._p_js = pub(JOINT_STATES, codecs.JOINT_STATE, base)
         self._p_measured = pub(WRENCH_MEASURED, codecs.WRENCH, base)
         # evaluation topics: sent only while someone listens
         self._p_hand = LoopPublisher(
