@@ -27,6 +27,7 @@ def _stub_modules(monkeypatch, launch_args: dict[str, str]) -> None:
     actions = types.ModuleType("launch.actions")
     actions.DeclareLaunchArgument = _Recorder
     actions.OpaqueFunction = _Recorder
+    actions.Shutdown = _Recorder
     subs = types.ModuleType("launch.substitutions")
 
     class LaunchConfiguration:
@@ -74,6 +75,9 @@ def test_launch_file_is_installed_and_plans_the_session(monkeypatch) -> None:
     device = nodes[-1].kwargs["parameters"][0]
     assert device["clock_mode"] == "lockstep" and device["rate_hz"] == 1000.0
     assert device["hand.behaviour"] == "semi_random"
+    for n in nodes:  # every process is required: its end shuts the launch down
+        assert type(n.kwargs["on_exit"]).__name__ == "_Recorder", n.kwargs
+        assert "ended" in n.kwargs["on_exit"].kwargs["reason"]
     for pkg, exe, _ in planned:
         shim = Path(get_package_share_directory(pkg)).parents[1] / "lib" / pkg / exe
         assert shim.is_file(), shim
@@ -92,6 +96,7 @@ def test_launch_file_composes_the_loop_by_default(monkeypatch) -> None:
         "device_node",
     ]
     assert node.kwargs["namespace"] == "slide1" and "name" not in node.kwargs
+    assert "device_node" in node.kwargs["on_exit"].kwargs["reason"]
     (params_file,) = node.kwargs["parameters"]
     doc = yaml.safe_load(Path(params_file).read_text())
     assert doc["/**/device_node"]["ros__parameters"]["clock_mode"] == "lockstep"

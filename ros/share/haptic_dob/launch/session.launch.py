@@ -3,14 +3,16 @@
 The simulated session graph for the ROS 2 command line, the same plan as ``haptic-launch``
 (which needs no ROS 2 command line), from the same YAML: the loop's nodes (device, environment,
 observer, controller) in one process (``ros2 run haptic_dob container``, their messages handed
-over in process) unless ``composed:=false``, a recorder apart, in ``namespace``.
+over in process) unless ``composed:=false``, a recorder apart, in ``namespace``. Every process
+is required: when the device finishes a lockstep run (``duration_s``) or any node process ends
+(a crash, a kill), the launch shuts the whole graph down, as ``haptic-launch`` does.
 """
 
 import tempfile
 from pathlib import Path
 
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, OpaqueFunction
+from launch.actions import DeclareLaunchArgument, OpaqueFunction, Shutdown
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
@@ -46,6 +48,7 @@ def _nodes(context, *args, **kwargs):
                     namespace=namespace,
                     parameters=[{**common, **params[name]}],
                     output="screen",
+                    on_exit=Shutdown(reason=f"{name} ended"),
                 )
             )
         elif name == group[-1]:  # one process for the group, where its last node would start
@@ -58,6 +61,7 @@ def _nodes(context, *args, **kwargs):
                     namespace=namespace,
                     parameters=[str(write_params_file(params, folder))],
                     output="screen",
+                    on_exit=Shutdown(reason=f"{', '.join(group)} ended"),
                 )
             )
     return out
