@@ -77,26 +77,44 @@ def test_executable_resolves_starts_and_stops_on_sigint(package: str, name: str)
             proc.wait(5)
 
 
-@pytest.mark.parametrize("delay_s", [0.0, 0.3, 1.0, 2.5])
+def _mapped(pid: int, library: str) -> bool:
+    """Whether process ``pid`` has a shared object whose path contains ``library`` mapped."""
+    try:
+        return library in Path(f"/proc/{pid}/maps").read_text()
+    except OSError:
+        return False
+
+
+#: start-up phases at which the SIGINT comes: the node's imports under way (numpy's extension
+#: mapped, rclpy's not yet or just), and rclpy loaded (its extension mapped; node being built)
+PHASES = {"importing": "_multiarray_umath", "rclpy_loaded": "_rclpy_pybind11"}
+
+
+@pytest.mark.parametrize("phase", list(PHASES))
 @pytest.mark.parametrize(
     ("package", "name"),
     [("haptic_sim", "device_node"), ("haptic_dob", "controller_node")],
     ids=["device_node", "controller_node"],
 )
-def test_ctrl_c_during_start_up_ends_quietly(package: str, name: str, delay_s: float) -> None:
-    """``ros2 launch`` or a terminal sends SIGINT while the node still imports or starts: it
-    ends with 0 (node up), 130 (still importing) or by the signal itself (before Python ran),
-    never with a traceback."""
+def test_ctrl_c_during_start_up_ends_quietly(package: str, name: str, phase: str) -> None:
+    """``ros2 launch`` or a terminal sends SIGINT while the node still imports numpy, pinocchio
+    and rclpy or builds itself: it ends at once, with 130 (still importing) or 0 (its clean
+    shutdown), never with a traceback, and the signal is never lost. (A SIGINT within the
+    interpreter's own first tenth of a second, while it reads its site packages, is CPython's
+    to handle and may print its traceback; the shim keeps the wheels' re-exec out of the way.)"""
     exe = Path(get_package_prefix(package)) / "lib" / package / name
     proc = subprocess.Popen(
         [str(exe)], env=isolated_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT
     )
     try:
-        time.sleep(delay_s)
+        end = time.monotonic() + 60.0  # a hang guard: the phase comes within the start-up
+        while not _mapped(proc.pid, PHASES[phase]) and time.monotonic() < end:
+            time.sleep(0.002)
+        assert proc.poll() is None, "the node ended by itself"
         proc.send_signal(signal.SIGINT)
-        out, _ = proc.communicate(timeout=30)
+        out, _ = proc.communicate(timeout=30)  # lost signal: TimeoutExpired
         assert b"Traceback" not in out and b"KeyboardInterrupt" not in out, out.decode()
-        assert proc.returncode in (0, 130, -signal.SIGINT), (proc.returncode, out.decode())
+        assert proc.returncode in (0, 130), (proc.returncode, out.decode())
     finally:
         if proc.poll() is None:
             proc.kill()
