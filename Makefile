@@ -34,6 +34,7 @@ $(STAMP): pyproject.toml constraints.txt $(INSTALLED_DATA)
 lint: $(STAMP)
 	@$(BIN)/ruff check src test scripts
 	@$(BIN)/ruff format --check src test scripts
+	@$(BIN)/mypy
 
 bench: $(STAMP)
 	@$(BIN)/python scripts/benchmarks.py

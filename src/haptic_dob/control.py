@@ -50,12 +50,6 @@ class ControlMode(StrEnum):
             raise ValueError(f"mode must be one of {choices}, got {value!r}") from None
 
 
-def force3(name: str, value: ArrayLike) -> Force:
-    """Validate a 3-vector force (N) and return it as a tuple of floats."""
-    v = vector(name, value, 3)
-    return (float(v[0]), float(v[1]), float(v[2]))
-
-
 @dataclass(frozen=True)
 class ImpedanceLaw:
     """One consistent snapshot of the law's settings: mode, force gain Kf and force limit.

@@ -67,7 +67,11 @@ class VirtualWall:
         """1-D wall at ``position_m`` along ``axis``, penetrated when moving along +axis."""
         a = unit_vector("axis", axis)
         x = finite_scalar("position_m", position_m)
-        return cls(stiffness_n_per_m, damping_n_s_per_m, tuple(float(v) for v in a * x), tuple(a))
+        p = a * x
+        point = (float(p[0]), float(p[1]), float(p[2]))
+        return cls(
+            stiffness_n_per_m, damping_n_s_per_m, point, (float(a[0]), float(a[1]), float(a[2]))
+        )
 
     def penetration(self, p: ArrayLike) -> float:
         """Signed penetration depth (m): > 0 inside the wall."""
@@ -94,7 +98,7 @@ class VirtualWall:
     def force_checked(self, p: ArrayLike, v: ArrayLike) -> Vec3:
         """``force`` with shape and finiteness checks (``ValueError`` names the argument)."""
         p3, v3 = vector("p", p, 3), vector("v", v, 3)
-        return self.force(tuple(p3.tolist()), tuple(v3.tolist()))  # type: ignore[arg-type]
+        return self.force(tuple(p3.tolist()), tuple(v3.tolist()))
 
     def desired_impedance(self, freqs_hz: ArrayLike) -> np.ndarray:
         """Desired impedance Z_d(j w) = K + j B w (N/m) at ``freqs_hz``."""

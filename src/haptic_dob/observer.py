@@ -35,6 +35,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -89,6 +90,8 @@ class DisturbanceObserver:
         dls_damping_m: the damping at a fully singular J (m).
     """
 
+    _z: Vec  # the state, set by reset() (N or N m)
+
     def __init__(
         self,
         model: DeviceModel,
@@ -135,7 +138,7 @@ class DisturbanceObserver:
     def _set_gain(self, gain: float) -> None:
         self.gain = positive("gain", gain)
         if self._scalar:
-            m = self.model.mass_kg  # type: ignore[attr-defined]
+            m = self.model.mass_kg  # type: ignore[attr-defined]  # scalar models are SlideModel
             self._alpha = math.exp(-self.gain * self.dt / m)
             self.discrete_gain = m * math.expm1(self.gain * self.dt / m) / self.dt
         else:
@@ -165,9 +168,9 @@ class DisturbanceObserver:
         self._z = np.zeros(n)
         self._D_prev: Mat = np.zeros((n, n))
         self._h_prev: Vec = np.zeros(n)
-        self._z_s = 0.0
-        self._h_s = 0.0
-        self._v_last = 0.0
+        self._z_s: float = 0.0
+        self._h_s: float = 0.0
+        self._v_last: float = 0.0
         self._qd_last: Vec = np.zeros(n)
         self._estimate = np.zeros(n)
 
@@ -193,7 +196,7 @@ class DisturbanceObserver:
         D, h = self._dynamics(q_, qd_)
         if self._initialised:
             rhs = self._D_prev @ self._z + (T * c) * (self._h_prev - tau_ - c * qd_)
-            self._z = np.linalg.solve(self._D_prev + self._tc_eye, rhs)
+            self._z = cast(Vec, np.linalg.solve(self._D_prev + self._tc_eye, rhs))
             d = self._z + c * qd_
         else:
             self._z = -c * qd_
@@ -201,8 +204,9 @@ class DisturbanceObserver:
             self._initialised = True
         self._D_prev, self._h_prev = D, h
         self._qd_last = qd_
-        if self.limit is not None:
-            d = np.minimum(np.maximum(d, self._neg_limit), self.limit)
+        lim, neg = self.limit, self._neg_limit
+        if lim is not None and neg is not None:
+            d = np.minimum(np.maximum(d, neg), lim)
         self._estimate = d
         return d.copy()
 
@@ -215,14 +219,14 @@ class DisturbanceObserver:
         n = self._n
         try:
             if (
-                len(q) == n  # type: ignore[arg-type]
-                and len(qd) == n  # type: ignore[arg-type]
-                and len(tau) == n  # type: ignore[arg-type]
+                len(q) == n  # type: ignore[arg-type]  # checked Sequence on the fast path
+                and len(qd) == n  # type: ignore[arg-type]  # same
+                and len(tau) == n  # type: ignore[arg-type]  # same
                 and not isinstance(q, (str, bytes))
                 and not isinstance(qd, (str, bytes))
                 and not isinstance(tau, (str, bytes))
             ):
-                v = np.array((*q, *qd, *tau), dtype=np.float64)  # type: ignore[misc]
+                v = np.array((*q, *qd, *tau), dtype=np.float64)  # type: ignore[misc]  # sequences of floats here
                 if v.ndim == 1 and math.isfinite(v @ v):
                     return v[:n], v[n : 2 * n], v[2 * n :]
         except (TypeError, ValueError):
@@ -232,7 +236,7 @@ class DisturbanceObserver:
     def _vector(self, name: str, value: ArrayLike) -> Vec:
         """``value`` as a finite float vector of length dof (fast path, then full checks)."""
         try:
-            if len(value) == self._n and not isinstance(value, (str, bytes)):  # type: ignore[arg-type]
+            if len(value) == self._n and not isinstance(value, (str, bytes)):  # type: ignore[arg-type]  # sized, checked just above
                 v = np.array(value, dtype=np.float64)
                 if v.ndim == 1 and math.isfinite(v @ v):
                     return v
@@ -249,7 +253,7 @@ class DisturbanceObserver:
         scalar_of("q", q)
         v = scalar_of("qd", qd)
         u = scalar_of("tau", tau)
-        model: SlideModel = self.model  # type: ignore[assignment]
+        model: SlideModel = self.model  # type: ignore[assignment]  # the scalar path has a SlideModel
         c, alpha = self.discrete_gain, self._alpha
         if self._initialised:
             self._z_s = alpha * self._z_s + (1.0 - alpha) * (self._h_s - u - c * v)
@@ -272,7 +276,7 @@ class DisturbanceObserver:
         """End-effector force F_hat (N), (3,), with J(q)^T F_hat = d_hat (damped least squares)."""
         if self._scalar:
             scalar_of("q", q)
-            return self.model.axis * float(self._estimate[0])  # type: ignore[attr-defined]
+            return self.model.axis * float(self._estimate[0])  # type: ignore[attr-defined]  # the scalar path has a SlideModel
         J = self.model._jacobian(self._vector("q", q))
         d = self._estimate
         if J.shape == (3, 3):

@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike, NDArray
 def finite_scalar(name: str, value: object) -> float:
     """Return ``value`` as a finite float or raise ``ValueError`` naming ``name``."""
     try:
-        x = float(value)  # type: ignore[arg-type]
+        x = float(value)  # type: ignore[arg-type]  # any object; refusal below
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a real number, got {value!r}") from None
     if not math.isfinite(x):
@@ -68,11 +68,11 @@ def scalar_of(name: str, value: object) -> float:
     """Return the single finite element of a scalar or length-1 sequence (fast path of the loop)."""
     kind = type(value)
     if kind is float:
-        x = value  # type: ignore[assignment]
+        x: float = value  # type: ignore[assignment]  # checked: a float
     elif kind is tuple or kind is list or kind is np.ndarray or kind is array.array:
-        if len(value) != 1:  # type: ignore[arg-type]
+        if len(value) != 1:  # type: ignore[arg-type]  # a sized kind, checked above
             raise ValueError(f"{name} must be a scalar or a length-1 vector, got {value!r}")
-        x = float(value[0])  # type: ignore[index]
+        x = float(value[0])  # type: ignore[index]  # same
     elif isinstance(value, (int, np.floating, np.integer)) and not isinstance(value, bool):
         x = float(value)
     elif isinstance(value, Sequence) and not isinstance(value, str) and len(value) == 1:

@@ -158,7 +158,7 @@ class JointReader:
         start = self._start
         if start and len(data) == self._size and data[12:start] == self._key:
             sec, nsec = _STAMP2.unpack_from(data, 4)
-            v = self._values.unpack_from(data, start)  # type: ignore[union-attr]
+            v = self._values.unpack_from(data, start)  # type: ignore[union-attr]  # set whenever _start is
             a, b, _ = self._counts
             return sec * NS_PER_S + nsec, self._names, v[:a], v[a : a + b], v[a + b :]
         return self._learn(data)

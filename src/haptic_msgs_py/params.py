@@ -141,8 +141,12 @@ def specs_of(cls: type, prefix: str = "", read_only: bool | None = None) -> list
         meta = f.metadata.get("param")
         if meta is None:
             continue
-        missing = f.default is dataclasses.MISSING
-        default = f.default_factory() if missing else f.default  # type: ignore[misc]
+        if f.default is not dataclasses.MISSING:
+            default = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            default = f.default_factory()
+        else:
+            raise TypeError(f"{cls.__name__}.{f.name} is a parameter without a default")
         length = None
         if isinstance(default, tuple):
             default, length = list(default), len(default)

@@ -9,6 +9,8 @@ newest one.
 
 from __future__ import annotations
 
+from typing import Any
+
 NS_PER_S = 1_000_000_000
 COMMAND_LABEL = "effort@"
 
@@ -18,14 +20,9 @@ def to_ns(sec: int, nanosec: int) -> int:
     return sec * NS_PER_S + nanosec
 
 
-def from_ns(ns: int) -> tuple[int, int]:
-    """(sec, nanosec) of integer nanoseconds."""
-    return divmod(ns, NS_PER_S)
-
-
-def stamp_ns(msg: object) -> int:
+def stamp_ns(msg: Any) -> int:
     """Nanoseconds of ``msg.header.stamp`` (works for rclpy and rosbags messages)."""
-    st = msg.header.stamp  # type: ignore[attr-defined]
+    st = msg.header.stamp
     return st.sec * NS_PER_S + st.nanosec
 
 

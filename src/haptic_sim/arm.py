@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import cast
 
 import numpy as np
 
@@ -59,12 +60,12 @@ _ZERO3 = np.zeros(3)
 def solve(A: Mat, b: Vec) -> Vec:
     """``A x = b``; a 3x3 system by cofactors in floats (several times faster than LAPACK here)."""
     if A.shape != (3, 3):
-        return np.linalg.solve(A, b)
+        return cast(Vec, np.linalg.solve(A, b))
     (a, b_, c), (d, e, f), (g, h, i) = A.tolist()
     c00, c01, c02 = e * i - f * h, f * g - d * i, d * h - e * g
     det = a * c00 + b_ * c01 + c * c02
     if det == 0.0 or not math.isfinite(det):
-        return np.linalg.solve(A, b)
+        return cast(Vec, np.linalg.solve(A, b))
     r = 1.0 / det
     x0, x1, x2 = b.tolist()
     return np.array(

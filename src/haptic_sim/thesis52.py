@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from haptic_dob.control import ImpedanceLaw
+from haptic_dob.control import ControlMode, ImpedanceLaw
 from haptic_dob.environment import VirtualWall
 from haptic_dob.models.phantom import HOME, PhantomModel
 from haptic_dob.observer import ObserverSettings, dls_transpose_solve
@@ -70,7 +70,7 @@ def free_motion(setup: Setup = Setup(), duration_s: float = 3.0) -> ArmSessionRe
         plant=PhantomModel(setup.params),
         observer_model=PhantomModel(setup.params, gravity=False),
         device=setup.device(FREE_MOTION_START),
-        law=ImpedanceLaw("OL", 0.0, 8.5),
+        law=ImpedanceLaw(ControlMode.OL, 0.0, 8.5),
         observer=ObserverSettings(setup.gain, 0.0),
     )
     return run_arm_session(cfg)
@@ -111,7 +111,7 @@ def wall_contact(
         observer_model=PhantomModel(setup.params, gravity=False),
         device=setup.device(start),
         wall=wall,
-        law=ImpedanceLaw("DOB", kf, 8.5),
+        law=ImpedanceLaw(ControlMode.DOB, kf, 8.5),
         observer=ObserverSettings(setup.gain, 0.0),
         exact_force=exact,
         hold_s=hold_s,

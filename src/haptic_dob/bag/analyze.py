@@ -254,6 +254,7 @@ def analyze_bag(
         skip = skip_samples(seg.size, st.settle_s if seg.index == 0 else st.transient_s, fs)
         window = slice(seg.start + skip, seg.stop)
         k_rec, b, p_axis, n_axis = _wall(seg, axis)
+        k: float | None
         if st.stiffness_n_per_m is not None:
             k, source = st.stiffness_n_per_m, "--stiffness"
         else:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -126,7 +127,7 @@ def _decode_vectors_slow(
     stamps = np.empty(len(datas), np.int64)
     values = np.empty((len(datas), len(cols)))
     for i, data in enumerate(datas):
-        msg = TYPESTORE.deserialize_cdr(data, typename)
+        msg: Any = TYPESTORE.deserialize_cdr(data, typename)
         st = msg.header.stamp
         stamps[i] = st.sec * NS_PER_S + st.nanosec
         vec = getattr(getattr(msg, outer), inner)
@@ -149,7 +150,7 @@ def decode_joint(
     vel = np.empty(n)
     names: list[str] = []
     for i, data in enumerate(datas):
-        msg = TYPESTORE.deserialize_cdr(data, "sensor_msgs/msg/JointState")
+        msg: Any = TYPESTORE.deserialize_cdr(data, "sensor_msgs/msg/JointState")
         if i == 0:
             names = list(msg.name)
         st = msg.header.stamp

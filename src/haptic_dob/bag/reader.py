@@ -274,7 +274,8 @@ def _joint_decoder(joint: str | None, shown: str, topic: str) -> Any:
 def _joint_names(data: bytes) -> list[str]:
     from haptic_msgs_py.wire import TYPESTORE
 
-    return list(TYPESTORE.deserialize_cdr(data, JOINT_STATE).name)
+    msg: Any = TYPESTORE.deserialize_cdr(data, JOINT_STATE)
+    return list(msg.name)
 
 
 def _param_value(v: Any) -> Any:

@@ -294,7 +294,7 @@ def write_session_bag(
             write(c_force, t, t_wrench.fill(stamp, (fk, 0.0, 0.0)))
             count += 2
             if c_twist is not None:
-                write(c_twist, t, t_twist.fill(stamp, (vs[k], 0.0, 0.0)))  # type: ignore[index]
+                write(c_twist, t, t_twist.fill(stamp, (vs[k], 0.0, 0.0)))  # type: ignore[index]  # vs is set whenever c_twist is
                 count += 1
             for c, tpl, kind in extra:
                 if kind == "f":

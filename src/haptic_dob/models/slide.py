@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -78,10 +77,6 @@ class SlideModel(DeviceModel):
 
     def _forward_kinematics(self, q: Vec) -> Vec:
         return self.axis * float(q[0])
-
-    def corner_frequency_hz(self, gain: float) -> float:
-        """Corner frequency c / (2 pi m) (Hz) of an observer with gain c (N s/m) on this slide."""
-        return gain / (2.0 * math.pi * self.mass_kg)
 
 
 @dataclass(frozen=True)

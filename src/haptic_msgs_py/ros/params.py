@@ -28,7 +28,7 @@ def ros_type(spec: ParamSpec) -> Parameter.Type:
     """The ROS parameter type a spec is declared with (arrays by their element type)."""
     if spec.kind is list:
         return {str: Parameter.Type.STRING_ARRAY, int: Parameter.Type.INTEGER_ARRAY}.get(
-            spec.item_kind, Parameter.Type.DOUBLE_ARRAY
+            spec.item_kind or float, Parameter.Type.DOUBLE_ARRAY
         )
     return {
         bool: Parameter.Type.BOOL,
@@ -150,7 +150,7 @@ class ParameterTable:
         for name in self.specs:
             self.values[name] = normalise(self.specs[name], node.get_parameter(name).value)
         self._declaring = False
-        self.settings = validate(self.values) if validate else None
+        self.settings: Any = validate(self.values) if validate else None
 
     def set_validator(
         self,

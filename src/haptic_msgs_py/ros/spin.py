@@ -87,7 +87,7 @@ class LoopNode(Node):
     def _stamp_on_loop_time(self, params: list[Parameter]) -> SetParametersResult:
         stamp = self.next_sample_ns()
         if stamp is not None and not any(p.name == "use_sim_time" for p in params):
-            self._clock = _LoopTimeOnce(self, self._clock, stamp)  # type: ignore[assignment]
+            self._clock = _LoopTimeOnce(self, self._clock, stamp)  # type: ignore[assignment]  # a stand-in clock that rclpy's event stamping reads
         return SetParametersResult(successful=True)
 
     def _clock_back(self, _params: list[Parameter]) -> None:

@@ -116,7 +116,7 @@ def chapter6_runs(
     runs = []
     for mode, kf in controllers or CH6_CONTROLLERS:
         for wall in (walls or CH6_WALLS)[mode]:
-            extra = {
+            extra: dict[str, dict[str, Any]] = {
                 "/**": {"slide.coulomb_n": p.coulomb_n},
                 "device_node": {
                     "duration_s": p.pulse_at_s + p.observe_s,

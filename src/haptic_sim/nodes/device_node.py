@@ -382,7 +382,7 @@ class DeviceNode(LoopNode):
             self._recorder_ns is not None and self._recorder_ns >= last_ns
         ):
             self.finished = True
-        elif time.monotonic() >= self._drain_until:
+        elif self._drain_until is not None and time.monotonic() >= self._drain_until:
             self.get_logger().warning(
                 f"the recorder has not written the last sample after {DRAIN_TIMEOUT_S:g} s; "
                 "stopping anyway"
