@@ -20,7 +20,7 @@ reproduce: $(STAMP)
 # CI= : pytest prints whole assertion diffs when CI is set; one failure's diff of a 5000-sample
 # list could then hide every other failure in a truncated log
 test: $(STAMP)
-	@CI= BUILD_NUMBER= $(BIN)/python -m pytest -q -p no:cacheprovider
+	@CI= BUILD_NUMBER= $(BIN)/python -m pytest -q -rs -p no:cacheprovider
 
 install: $(STAMP)
 

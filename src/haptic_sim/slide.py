@@ -187,7 +187,7 @@ class SimulatedSlide:
     def _discretise(self) -> None:
         """Matrix exponential of the linear part over one physics step (zero-order hold input)."""
         h = self.hand
-        M = self.model.mass_kg + h.mass_kg
+        M = self.model.mass_kg + (h.mass_kg if h.active else 0.0)  # no hand, no hand mass
         kh = h.stiffness_n_per_m if h.active else 0.0
         bh = h.damping_n_s_per_m if h.active else 0.0
         A = np.array([[0.0, 1.0], [-kh / M, -(self.model.viscous_n_s_per_m + bh) / M]])

@@ -1,0 +1,159 @@
+"""haptic-identify: the slide's model from a bag holding nothing but /joint_states.
+
+The bags are written here as a driver's recording would be (rosbags, MCAP and sqlite3) from the
+simulated slide with no hand, excited through its actuator under an 80 N/m virtual spring; the
+simulator's own physics is the truth the identification must find.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from haptic_dob.identification import JointRecord, identify
+from haptic_dob.identify_cli import main
+from haptic_dob.models.slide import SlideParams
+from haptic_msgs_py import wire
+from haptic_msgs_py.params import load_node_params
+from haptic_sim.hand import HandParams
+from haptic_sim.slide import SimulatedSlide
+
+TRUTH = SlideParams()  # m 0.416 kg, c 1.272 N s/m, Fc 0.24 N
+
+
+def simulate(
+    excite: Callable[[float], float], seconds: float, physics: SlideParams = TRUTH
+) -> JointRecord:
+    """The slide under ``excite(t)`` (N) plus an 80 N/m spring on the encoder position."""
+    slide = SimulatedSlide(physics=physics, hand=HandParams(behaviour="none"))
+    stamps, pos, eff = [], [], []
+    for k in range(round(seconds * 1000)):
+        s = slide.sample()
+        stamps.append(s.stamp_ns)
+        pos.append(s.q[0])
+        eff.append(s.effort[0])
+        slide.apply([excite(k * 1e-3) - 80.0 * s.q[0]])
+    return JointRecord(np.array(stamps), np.array(pos), np.array(eff), "slide")
+
+
+def chirp(t: float) -> float:
+    return 1.5 * math.sin(2.0 * math.pi * (0.3 * t + 0.25 * t * t))  # 0.3 Hz -> 10 Hz in 20 s
+
+
+def step(t: float) -> float:
+    return 2.4 if t >= 1.0 else 0.0  # the thesis's 2.4 N step
+
+
+def write_bag(
+    path: Path, rec: JointRecord, storage: str, effort: bool = True, topic: str = "/joint_states"
+) -> Path:
+    """A bag as ``ros2 bag record /joint_states`` of a driver would hold it."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    plugin = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}[storage]
+    writer = Writer(path, version=9, storage_plugin=plugin)
+    writer.open()
+    try:
+        conn = writer.add_connection(topic, "sensor_msgs/msg/JointState", typestore=wire.TYPESTORE)
+        msg = wire.joint_state(["slide"], "base_link")
+        for st, q, u in zip(rec.stamps_ns.tolist(), rec.position, rec.effort, strict=True):
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(st), 1_000_000_000)
+            msg.position = np.array([q])
+            msg.velocity = np.array([0.0])
+            msg.effort = np.array([u]) if effort else np.array([], np.float64)
+            writer.write(conn, int(st) + 1, wire.encode(msg))
+    finally:
+        writer.close()
+    return path
+
+
+@pytest.fixture(scope="module")
+def chirp_record() -> JointRecord:
+    return simulate(chirp, 20.0)
+
+
+def test_least_squares_finds_mass_viscous_and_coulomb_friction(chirp_record) -> None:
+    fit = identify(chirp_record)
+    assert fit.mass_kg == pytest.approx(TRUTH.mass_kg, rel=0.03)
+    assert fit.viscous_n_s_per_m == pytest.approx(TRUTH.viscous_n_s_per_m, rel=0.03)
+    assert fit.coulomb_n == pytest.approx(TRUTH.coulomb_n, rel=0.05)
+    assert fit.mass_std is not None and 0.0 < fit.mass_std < 0.05 * fit.mass_kg
+
+
+def test_step_method_finds_mass_and_damping_without_friction() -> None:
+    """The thesis's method is exact for the linear plant; Coulomb friction makes it read the
+    friction as extra damping (why the thesis verified the model with other inputs)."""
+    linear = SlideParams(coulomb_n=0.0)
+    fit = identify(simulate(step, 5.0, linear), "step")
+    assert fit.mass_kg == pytest.approx(linear.mass_kg, rel=0.05)
+    assert fit.viscous_n_s_per_m == pytest.approx(linear.viscous_n_s_per_m, rel=0.05)
+    assert fit.coulomb_n is None
+    with_friction = identify(simulate(step, 5.0), "step")
+    assert with_friction.mass_kg == pytest.approx(TRUTH.mass_kg, rel=0.05)
+    assert with_friction.viscous_n_s_per_m > 1.2 * TRUTH.viscous_n_s_per_m
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_cli_reads_a_joint_states_only_bag_and_writes_the_model(
+    tmp_path, capsys, chirp_record, storage
+) -> None:
+    bag = write_bag(tmp_path / "bag", chirp_record, storage)
+    model = tmp_path / "model.yaml"
+    assert main([str(bag), "--json", "--write-yaml", str(model)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mass_kg"] == pytest.approx(TRUTH.mass_kg, rel=0.03)
+    assert out["viscous_n_s_per_m"] == pytest.approx(TRUTH.viscous_n_s_per_m, rel=0.03)
+    assert out["coulomb_n"] == pytest.approx(TRUTH.coulomb_n, rel=0.05)
+    params = load_node_params(model)["/**"]
+    assert params["slide.mass_kg"] == pytest.approx(out["mass_kg"])
+    assert params["slide.coulomb_n"] == pytest.approx(out["coulomb_n"])
+    assert main([str(bag)]) == 0
+    table = capsys.readouterr().out
+    assert "mass_kg" in table and "+-" in table
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "haptic_dob.identify_cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+def test_bad_bags_get_one_line_and_exit_2(tmp_path, chirp_record) -> None:
+    short = JointRecord(
+        chirp_record.stamps_ns[:50], chirp_record.position[:50], chirp_record.effort[:50], "slide"
+    )
+    still = JointRecord(
+        chirp_record.stamps_ns,
+        np.zeros(len(chirp_record.stamps_ns)),
+        np.zeros(len(chirp_record.stamps_ns)),
+        "slide",
+    )
+    cases = {
+        "no effort": (write_bag(tmp_path / "a", chirp_record, "mcap", effort=False), "no effort"),
+        "other topic": (
+            write_bag(tmp_path / "b", chirp_record, "mcap", topic="/arm/states"),
+            "no joint state topic",
+        ),
+        "too short": (write_bag(tmp_path / "c", short, "sqlite3"), "too short"),
+        "no motion": (write_bag(tmp_path / "d", still, "mcap"), "too little motion"),
+        "missing": (tmp_path / "nothing", "no such file"),
+    }
+    for what, (bag, reason) in cases.items():
+        out = _cli(str(bag))
+        assert out.returncode == 2, (what, out.stderr)
+        lines = out.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("ERROR:") and reason in lines[0], (
+            what,
+            out.stderr,
+        )
+        assert "Traceback" not in out.stderr
