@@ -4,7 +4,8 @@ Reads the joint states of a recorded session (MCAP or sqlite3; ours or ``ros2 ba
 ``/joint_states`` alone is enough) and identifies ``m x'' + c x' + Fc sgn(x') = u`` by least
 squares (default) or by the thesis's step method (``--method step``, under a virtual spring).
 Prints a table, or one JSON line (``--json``); ``--write-yaml FILE`` writes the observer's model
-as a params file (``/**: ros__parameters: slide.*``) the nodes load after the session's config.
+as a params file (``slide.*`` of the observer and the controller, the nodes that assume a model)
+to load after the session's config.
 """
 
 from __future__ import annotations
@@ -37,12 +38,17 @@ def table(fit: SlideFit, bag: str) -> str:
     return "\n".join(rows)
 
 
+#: the nodes that assume a model of the device (the device node keeps its own physics)
+MODEL_NODES = ("observer_node", "controller_node")
+
+
 def model_yaml(fit: SlideFit, bag: str) -> str:
-    """A params file that sets the observer's (and controller's) assumed slide model."""
+    """A params file that sets the assumed slide model of the observer and the controller."""
     import yaml
 
     head = f"# identified from {bag} by haptic-identify ({fit.method}, joint {fit.joint})\n"
-    return head + yaml.safe_dump({"/**": {"ros__parameters": fit.as_params()}}, sort_keys=False)
+    doc = {f"/**/{n}": {"ros__parameters": fit.as_params()} for n in MODEL_NODES}
+    return head + yaml.safe_dump(doc, sort_keys=False)
 
 
 def command(
