@@ -30,22 +30,27 @@ ROLES: dict[str, tuple[list[str], list[str]]] = {
 }
 
 
-def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
-    """One process of the pattern; the device times ``cycles`` cycles and puts the median."""
+def peer_node(name: str, domain: str) -> tuple[Any, Any, Any]:
+    """(context, node, events executor) of a benchmark process on ``domain``, localhost only."""
     os.environ["ROS_DOMAIN_ID"] = domain
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     import rclpy
     from rclpy.context import Context
     from rclpy.experimental import EventsExecutor
+
+    ctx = Context()
+    rclpy.init(context=ctx, args=[])
+    return ctx, rclpy.create_node(name, context=ctx), EventsExecutor(context=ctx)
+
+
+def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
+    """One process of the pattern; the device times ``cycles`` cycles and puts the median."""
+    ctx, node, ex = peer_node(f"pattern_{role}", domain)
     from std_msgs.msg import Header
 
     from haptic_msgs_py import wire
     from haptic_msgs_py.ros.qos import ESTIMATOR_IN, LOOP, LOOP_IN
 
-    ctx = Context()
-    rclpy.init(context=ctx, args=[])
-    node = rclpy.create_node(f"pattern_{role}", context=ctx)
-    ex = EventsExecutor(context=ctx)
     data = wire.encode(wire.header("base_link"))
     sends, waits = ROLES[role]
     pubs = [node.create_publisher(Header, t, LOOP) for t in sends]

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_pattern import pattern_cycle_us
+from bench_pattern import pattern_cycle_us, peer_node
 
 
 def machine() -> str:
@@ -83,20 +83,12 @@ def batch_cycle_us(mode: str = "DOB", kf: float = 1.0, seconds: float = 10.0) ->
 def _hop_peer(role: str, n: int, domain: str, out: Any) -> None:
     """One side of the ping-pong: ``a`` sends and times, ``b`` echoes (raw bytes, events
     executor, the loop's QoS: reliable transient-local publisher, best-effort subscription)."""
-    os.environ["ROS_DOMAIN_ID"] = domain
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    import rclpy
-    from rclpy.context import Context
-    from rclpy.experimental import EventsExecutor
+    ctx, node, ex = peer_node(f"hop_{role}", domain)
     from std_msgs.msg import Header
 
     from haptic_msgs_py import wire
     from haptic_msgs_py.ros.qos import LOOP, LOOP_IN
 
-    ctx = Context()
-    rclpy.init(context=ctx, args=[])
-    node = rclpy.create_node(f"hop_{role}", context=ctx)
-    ex = EventsExecutor(context=ctx)
     send, receive = ("ping", "pong") if role == "a" else ("pong", "ping")
     pub = node.create_publisher(Header, send, LOOP)
     state = {"got": 0}
