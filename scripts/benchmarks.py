@@ -368,7 +368,7 @@ def bench_timer_floor(repeat: int) -> str:
     import multiprocessing
     import queue
 
-    from haptic_msgs_py.cpu_latency import hold
+    from haptic_dob.runtime.cpu_latency import hold
 
     ctx = multiprocessing.get_context("spawn")
     prio = latency = None

@@ -37,7 +37,7 @@ def _no_ros_domain_leak(monkeypatch: pytest.MonkeyPatch) -> None:
 def can_request_cpu_latency() -> bool:
     """Whether this test run may make PM QoS requests: the device opens for writing (root, and
     no container rule against it). An open without a write makes no request."""
-    from haptic_msgs_py.cpu_latency import PM_QOS_PATH
+    from haptic_dob.runtime.cpu_latency import PM_QOS_PATH
 
     try:
         os.close(os.open(PM_QOS_PATH, os.O_RDWR))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import ast
+import pathlib
 import pkgutil
 import subprocess
 import sys
@@ -43,3 +45,36 @@ def test_core_modules_do_not_import_rclpy() -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "", f"rclpy imported by the core: {out.stdout.strip()}"
+
+
+# scripts -> haptic_sim -> haptic_dob -> haptic_msgs_py: a package imports only those after it
+LAYERS = ("haptic_sim", "haptic_dob", "haptic_msgs_py")
+
+
+def imported_packages(path: pathlib.Path) -> set[str]:
+    """The project packages a source file imports (any import statement, at any depth)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found.update(alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            found.add(node.module.split(".")[0])
+    return found & set(LAYERS)
+
+
+def test_layers_have_no_arrow_back() -> None:
+    src = pathlib.Path(haptic_dob.__file__).resolve().parents[1]
+    back = []
+    for i, pkg in enumerate(LAYERS):
+        above = set(LAYERS[:i])
+        for path in sorted((src / pkg).rglob("*.py")):
+            for name in sorted(imported_packages(path) & above):
+                back.append(f"{path.relative_to(src)} imports {name}")
+    assert back == []
+
+
+def test_messages_package_holds_no_runtime() -> None:
+    """haptic_msgs_py holds topics, QoS, values, wire format and conversions, not the runtime."""
+    names = {m.name.rsplit(".", 1)[-1] for m in pkgutil.walk_packages(haptic_msgs_py.__path__)}
+    assert not names & {"params", "cpus", "cpu_latency", "entry", "spin"}

@@ -10,7 +10,7 @@ import pytest
 from conftest import can_request_cpu_latency
 from haptic_dob.cli import CliError
 from haptic_dob.launcher import add_cpu_latency
-from haptic_msgs_py.cpu_latency import NO_REQUEST, current, hold, strictest
+from haptic_dob.runtime.cpu_latency import NO_REQUEST, current, hold, strictest
 
 
 def test_a_request_writes_the_bound_as_a_32_bit_integer_and_stays_open(tmp_path) -> None:

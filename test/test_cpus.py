@@ -8,7 +8,7 @@ import textwrap
 
 import pytest
 
-from haptic_msgs_py.cpus import available_cpus, checked_cpus, placement
+from haptic_dob.runtime.cpus import available_cpus, checked_cpus, placement
 
 LOOP = ["device_node", "environment_node", "controller_node", "observer_node"]
 
@@ -78,7 +78,7 @@ def test_pin_process_pins_every_thread_also_those_started_before() -> None:
     code = textwrap.dedent(
         f"""
         import os, threading
-        from haptic_msgs_py.cpus import pin_process
+        from haptic_dob.runtime.cpus import pin_process
         stop = threading.Event()
         early = threading.Thread(target=stop.wait)
         early.start()

@@ -20,8 +20,8 @@ import pytest
 from haptic_dob.identification import JointRecord, identify
 from haptic_dob.identify_cli import main
 from haptic_dob.models.slide import SlideParams
+from haptic_dob.runtime.params import load_node_params
 from haptic_msgs_py import wire
-from haptic_msgs_py.params import load_node_params
 from haptic_sim.hand import HandParams
 from haptic_sim.slide import SimulatedSlide
 

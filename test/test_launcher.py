@@ -264,7 +264,7 @@ def _affinity_of_every_thread(pid: int) -> set[int]:
 @pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="--pin needs 2 CPUs")
 def test_pin_runs_each_node_process_on_its_planned_cpu(root, tmp_path) -> None:
     """Every thread of each node process (the middleware's too) runs on the CPU of the plan."""
-    from haptic_msgs_py.cpus import available_cpus, placement
+    from haptic_dob.runtime.cpus import available_cpus, placement
 
     plan = placement(list(NODE_NAMES.values()), available_cpus())
     log = tmp_path / "launch.log"
@@ -314,7 +314,7 @@ def _holds_cpu_latency(pid: int) -> bool:
 @pytest.mark.skipif(not can_request_cpu_latency(), reason="PM QoS requests need root")
 def test_cpu_latency_is_held_while_the_graph_runs_and_withdrawn_after(tmp_path) -> None:
     """Each loop node process holds the request; the kernel applies it until the graph stops."""
-    from haptic_msgs_py.cpu_latency import current
+    from haptic_dob.runtime.cpu_latency import current
 
     before = current()
     if before == 0:
@@ -363,7 +363,7 @@ def test_a_graph_stopped_while_its_nodes_start_stops_quietly() -> None:
 def test_pin_on_one_cpu_is_one_line(monkeypatch) -> None:
     from haptic_dob import launcher
     from haptic_dob.cli import CliError
-    from haptic_msgs_py import cpus
+    from haptic_dob.runtime import cpus
 
     monkeypatch.setattr(cpus, "available_cpus", lambda: [0])
     with pytest.raises(CliError, match="--pin: pinning needs at least 2 CPUs"):

@@ -125,7 +125,7 @@ def test_the_config_files_apply_in_any_namespace(monkeypatch, config: str, names
     from haptic_dob.nodes.controller_node import ControllerNode
     from haptic_dob.nodes.environment_node import EnvironmentNode
     from haptic_dob.nodes.observer_node import ObserverNode
-    from haptic_msgs_py.params import load_node_params, node_view
+    from haptic_dob.runtime.params import load_node_params, node_view
 
     path = Path(__file__).resolve().parents[1] / "config" / config
     sections = load_node_params(path)

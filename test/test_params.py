@@ -6,7 +6,7 @@ import pytest
 
 from haptic_dob.control import ImpedanceLaw
 from haptic_dob.environment import VirtualWall
-from haptic_msgs_py.params import ParamSpec, build, specs_of, values_of
+from haptic_dob.runtime.params import ParamSpec, build, specs_of, values_of
 from haptic_sim.hand import HandParams
 
 

@@ -23,8 +23,8 @@ from numpy.typing import ArrayLike
 
 from haptic_dob.models.base import DeviceModel
 from haptic_dob.models.slide import SlideModel
+from haptic_dob.runtime.params import param
 from haptic_dob.validation import nonnegative, positive, vector
-from haptic_msgs_py.params import param
 
 Force = tuple[float, float, float]
 ZERO_FORCE: Force = (0.0, 0.0, 0.0)

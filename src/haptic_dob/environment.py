@@ -18,8 +18,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from haptic_dob.runtime.params import param
 from haptic_dob.validation import finite_scalar, nonnegative, unit_vector, vector
-from haptic_msgs_py.params import param
 
 Vec3 = tuple[float, float, float]
 

@@ -38,7 +38,7 @@ import yaml
 from haptic_dob.cli import ArgumentParser, CliError, run
 from haptic_dob.configs import resolve_config
 from haptic_dob.nodes.registry import CONTAINER, LOOP_NODES, NODES, START_ORDER
-from haptic_msgs_py.params import load_node_params
+from haptic_dob.runtime.params import load_node_params
 
 __all__ = ["NODES", "START_ORDER", "command", "main", "plan", "resolved_params"]
 
@@ -121,9 +121,9 @@ def add_recorder(params: dict[str, Any], output: str, storage: str) -> None:
 
 def add_pinning(params: dict[str, Any]) -> str:
     """``--pin``: each loop node's ``cpu_affinity`` from the critical-path placement
-    (``haptic_msgs_py.cpus``), unless the config (its node section or ``/**``) or ``--set`` gave
+    (``haptic_dob.runtime.cpus``), unless the config (its node section or ``/**``) or ``--set`` gave
     one; returns the plan's text."""
-    from haptic_msgs_py.cpus import available_cpus, describe, placement
+    from haptic_dob.runtime.cpus import available_cpus, describe, placement
 
     try:
         assigned = placement([n for n in params if n != "/**"], available_cpus())
@@ -144,8 +144,8 @@ def add_pinning(params: dict[str, Any]) -> str:
 def add_cpu_latency(params: dict[str, Any], latency_us: int) -> None:
     """``--cpu-latency``: each loop node's ``cpu_latency_us``, unless the config or ``--set``
     gave a request (its node section or ``/**``; -1, no request, counts as not given)."""
-    from haptic_msgs_py.cpu_latency import NO_REQUEST
-    from haptic_msgs_py.cpus import PAIRS
+    from haptic_dob.runtime.cpu_latency import NO_REQUEST
+    from haptic_dob.runtime.cpus import PAIRS
 
     if not 0 <= latency_us <= 1_000_000:
         raise CliError(f"--cpu-latency {latency_us}: must be 0 to 1000000 us (0: idle CPUs poll)")
@@ -158,7 +158,7 @@ def add_cpu_latency(params: dict[str, Any], latency_us: int) -> None:
 def check_cpu_latency_request(latency_us: int) -> None:
     """Make the request once and withdraw it: a launch that cannot make it stops before any
     node starts, with the reason (``CliError``)."""
-    from haptic_msgs_py.cpu_latency import hold
+    from haptic_dob.runtime.cpu_latency import hold
 
     try:
         os.close(hold(latency_us))

@@ -42,8 +42,8 @@ from numpy.typing import ArrayLike
 
 from haptic_dob.models.base import DeviceModel, Mat, Vec
 from haptic_dob.models.slide import SlideModel
+from haptic_dob.runtime.params import param
 from haptic_dob.validation import nonnegative, positive, scalar_of, vector
-from haptic_msgs_py.params import param
 
 #: default observer gain c (N s/m): time constant m/c = 10 ms on the slide, corner 15.9 Hz
 DEFAULT_GAIN = 41.6

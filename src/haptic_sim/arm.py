@@ -42,8 +42,8 @@ from typing import cast
 import numpy as np
 
 from haptic_dob.models.base import DeviceModel, Mat, Vec
+from haptic_dob.runtime.params import param
 from haptic_dob.validation import nonnegative, positive, unit_vector, vector
-from haptic_msgs_py.params import param
 from haptic_sim.device import DeviceSample
 from haptic_sim.hand import HandParams, HandReference
 from haptic_sim.sensor import ForceSensor, ForceSensorParams

@@ -12,7 +12,7 @@ from typing import Any
 
 from haptic_dob.models.factory import build_model
 from haptic_dob.models.slide import SlideParams
-from haptic_msgs_py.params import ParamSpec, build, specs_of
+from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_sim.arm import ArmDeviceParams, SimulatedArm
 from haptic_sim.hand import HandParams
 from haptic_sim.sensor import ForceSensorParams

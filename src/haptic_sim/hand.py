@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal
 
+from haptic_dob.runtime.params import param
 from haptic_dob.validation import finite_scalar, nonnegative, positive
-from haptic_msgs_py.params import param
 
 BEHAVIOURS = ("semi_random", "push_hold", "none")
 BLOCK_S = 0.1  # s of reference per generated block: about 60 us of numpy at 10 kHz physics

@@ -24,8 +24,8 @@ from haptic_dob.cycle import LoopCycle
 from haptic_dob.environment import VirtualWall
 from haptic_dob.models.slide import SlideParams
 from haptic_dob.observer import ObserverSettings
+from haptic_dob.runtime.params import build, load_node_params, node_view, param, replace_groups
 from haptic_dob.validation import nonnegative, positive
-from haptic_msgs_py.params import build, load_node_params, node_view, param, replace_groups
 from haptic_sim.hand import HandParams
 from haptic_sim.sensor import ForceSensorParams
 from haptic_sim.slide import SimulatedSlide, SlideDeviceParams

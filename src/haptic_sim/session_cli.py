@@ -10,8 +10,8 @@ from haptic_dob.cli import ArgumentParser, run
 from haptic_dob.configs import resolve_config
 from haptic_dob.control import ControlMode
 from haptic_dob.environment import VirtualWall
+from haptic_dob.runtime.params import load_node_params, node_view
 from haptic_dob.validation import nonnegative, positive
-from haptic_msgs_py.params import load_node_params, node_view
 from haptic_sim.hand import reference_for_force
 from haptic_sim.session import SessionConfig, run_session
 from haptic_sim.stability import law_for

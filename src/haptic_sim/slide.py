@@ -24,8 +24,8 @@ import numpy as np
 from scipy.linalg import expm
 
 from haptic_dob.models.slide import SlideParams
+from haptic_dob.runtime.params import param
 from haptic_dob.validation import finite_scalar, positive
-from haptic_msgs_py.params import param
 from haptic_sim.device import DeviceSample
 from haptic_sim.hand import HandParams, HandReference
 from haptic_sim.sensor import ForceSensor, ForceSensorParams, quantize

@@ -18,7 +18,7 @@ from haptic_dob.models.base import DeviceModel
 from haptic_dob.models.phantom import PhantomSettings
 from haptic_dob.models.slide import SlideParams
 from haptic_dob.models.urdf import UrdfOptions, UrdfSettings
-from haptic_msgs_py.params import ParamSpec, build, specs_of
+from haptic_dob.runtime.params import ParamSpec, build, specs_of
 
 MODEL_KINDS = ("slide", "phantom", "urdf")
 

@@ -33,8 +33,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from haptic_dob.models._pinocchio import PinocchioModel, TreeJoint, tree_model
+from haptic_dob.runtime.params import param
 from haptic_dob.validation import finite_scalar, nonnegative
-from haptic_msgs_py.params import param
 
 #: the PHANToM's rest pose used as the default start: upper arm level, forearm hanging down
 HOME = (0.0, 0.0, math.pi / 2)

@@ -8,8 +8,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from haptic_dob.models.base import DeviceModel, Mat, Vec
+from haptic_dob.runtime.params import param
 from haptic_dob.validation import nonnegative, positive, unit_vector
-from haptic_msgs_py.params import param
 
 #: identified parameters of the thesis's slide (thesis table 4.1)
 SLIDE_MASS_KG = 0.416

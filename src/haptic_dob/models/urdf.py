@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from haptic_dob.models._pinocchio import PinocchioModel, urdf_model
-from haptic_msgs_py.params import param
+from haptic_dob.runtime.params import param
 
 
 class UrdfModel(PinocchioModel):

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from haptic_msgs_py.params import ParamSpec
+from haptic_dob.runtime.params import ParamSpec
 from haptic_msgs_py.topics import DEFAULT_BASE_FRAME
 
 CLOCK_MODES = ("lockstep", "realtime")
@@ -47,8 +47,8 @@ def process_specs() -> list[ParamSpec]:
 
 def main_for(node_class: type, args: list[str] | None = None) -> int:
     """``main()`` of a single-node executable: spin it until Ctrl-C/SIGTERM."""
+    from haptic_dob.runtime.ros.spin import run_nodes
     from haptic_msgs_py.ament import ensure_ament_prefix
-    from haptic_msgs_py.ros.spin import run_nodes
 
     ensure_ament_prefix()
     return run_nodes(lambda ctx: [node_class(context=ctx)], args)

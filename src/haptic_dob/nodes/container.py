@@ -47,8 +47,8 @@ def main(args: list[str] | None = None) -> int:
     except ValueError as exc:
         print(f"ERROR: {exc}", file=sys.stderr)
         return 2
+    from haptic_dob.runtime.ros.spin import run_nodes
     from haptic_msgs_py.ament import ensure_ament_prefix
-    from haptic_msgs_py.ros.spin import run_nodes
 
     ensure_ament_prefix()
     return run_nodes(

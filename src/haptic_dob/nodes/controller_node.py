@@ -35,13 +35,13 @@ from haptic_dob.cycle import FALLBACKS, CommandJoin
 from haptic_dob.models.factory import build_model, model_specs
 from haptic_dob.nodes.common import loop_specs, main_for, process_specs
 from haptic_dob.nodes.observer_node import JointMap, pick
+from haptic_dob.runtime.params import ParamSpec, build, specs_of
+from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
+from haptic_dob.runtime.ros.params import ParameterTable
+from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
-from haptic_msgs_py.params import ParamSpec, build, specs_of
 from haptic_msgs_py.ros import qos
-from haptic_msgs_py.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
-from haptic_msgs_py.ros.params import ParameterTable
-from haptic_msgs_py.ros.spin import LoopNode
 from haptic_msgs_py.topics import (
     EFFORT_COMMAND,
     JOINT_STATES,

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from haptic_msgs_py.entry import run_main
+from haptic_dob.runtime.entry import run_main
 
 
 def environment_node() -> int:

@@ -11,13 +11,13 @@ from rclpy.context import Context
 from haptic_dob.cycle import wall_force
 from haptic_dob.environment import VirtualWall
 from haptic_dob.nodes.common import loop_specs, main_for, process_specs
+from haptic_dob.runtime.params import ParamSpec, build, specs_of
+from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
+from haptic_dob.runtime.ros.params import ParameterTable
+from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
-from haptic_msgs_py.params import ParamSpec, build, specs_of
 from haptic_msgs_py.ros import qos
-from haptic_msgs_py.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
-from haptic_msgs_py.ros.params import ParameterTable
-from haptic_msgs_py.ros.spin import LoopNode
 from haptic_msgs_py.topics import EE_POSE, EE_TWIST, WRENCH_DESIRED
 from haptic_msgs_py.values import StampedVector
 

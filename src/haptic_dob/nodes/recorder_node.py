@@ -44,11 +44,11 @@ from rclpy.qos import (
 from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
 from haptic_dob.bag.write import parameter_event
 from haptic_dob.nodes.common import main_for
-from haptic_msgs_py.params import ParamSpec
+from haptic_dob.runtime.params import ParamSpec
+from haptic_dob.runtime.ros.params import ParameterTable
+from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py.ros import qos
-from haptic_msgs_py.ros.params import ParameterTable
 from haptic_msgs_py.ros.raw import rclpy_type
-from haptic_msgs_py.ros.spin import LoopNode
 from haptic_msgs_py.stamps import NS_PER_S, period_ns
 from haptic_msgs_py.topics import (
     EFFORT_COMMAND,
@@ -526,8 +526,8 @@ def record(
     """Run a recorder until SIGINT/SIGTERM or ``duration_s``; (exit code, the node if created)."""
     from rclpy.parameter import Parameter
 
+    from haptic_dob.runtime.ros.spin import run_nodes
     from haptic_msgs_py.ament import ensure_ament_prefix
-    from haptic_msgs_py.ros.spin import run_nodes
 
     ensure_ament_prefix()
     overrides = [

@@ -1,1 +1,2 @@
-"""The parts of the conventions that need rclpy: QoS profiles, parameter declaration, spinning."""
+"""The parts of the message conventions that need rclpy: QoS profiles, the loop's publishers and
+subscriptions, raw (serialized) subscriptions."""

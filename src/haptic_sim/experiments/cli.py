@@ -76,7 +76,7 @@ def command(
 ) -> int:
     """Run the chosen parts, analyse, write the report; raises on bad input or a failed run."""
     from haptic_dob.configs import resolve_config
-    from haptic_msgs_py.cpus import free_cpus, workers_for
+    from haptic_dob.runtime.cpus import free_cpus, workers_for
     from haptic_sim.experiments import graph_runs, plan, report, results
     from haptic_sim.session import SessionConfig
 

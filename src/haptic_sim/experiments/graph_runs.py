@@ -31,7 +31,7 @@ from typing import Any
 import yaml
 
 from haptic_dob.launcher import add_recorder
-from haptic_msgs_py.params import load_node_params
+from haptic_dob.runtime.params import load_node_params
 
 COMPLETE = "complete"
 

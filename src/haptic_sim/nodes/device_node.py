@@ -38,14 +38,14 @@ from rclpy.context import Context
 
 from haptic_dob.models.factory import model_specs
 from haptic_dob.nodes.common import CLOCK_MODES, loop_specs, main_for, process_specs
+from haptic_dob.runtime.params import ParamSpec
+from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
+from haptic_dob.runtime.ros.params import ParameterTable
+from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
-from haptic_msgs_py.params import ParamSpec
 from haptic_msgs_py.ros import qos
-from haptic_msgs_py.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
-from haptic_msgs_py.ros.params import ParameterTable
 from haptic_msgs_py.ros.raw import raw_subscription
-from haptic_msgs_py.ros.spin import LoopNode
 from haptic_msgs_py.stamps import NS_PER_S
 from haptic_msgs_py.topics import (
     CLOCK,

@@ -21,7 +21,7 @@ from rcl_interfaces.msg import (
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from haptic_msgs_py.params import ParamSpec
+from haptic_dob.runtime.params import ParamSpec
 
 
 def ros_type(spec: ParamSpec) -> Parameter.Type:

@@ -3,7 +3,7 @@
 ``ros2 launch`` and a terminal send SIGINT to a node that may still be importing numpy,
 pinocchio and rclpy; Python would print a ``KeyboardInterrupt`` traceback. ``run_main`` installs
 a SIGINT handler that exits with status 130 (128 + SIGINT) *before* importing the node's module;
-the node's runtime (``haptic_msgs_py.ros.spin.run_nodes``) replaces it with its clean shutdown
+the node's runtime (``haptic_dob.runtime.ros.spin.run_nodes``) replaces it with its clean shutdown
 once the node is up. ROS-free and light: it imports the module only by name.
 """
 

@@ -1,10 +1,10 @@
 """Declarative parameters: one table per settings dataclass, used by nodes, YAML and batch runs.
 
 A settings dataclass marks each field with ``param(...)`` metadata (description, unit, range,
-choices, read-only). ``specs_of`` turns the fields into ``ParamSpec`` rows; nodes declare them as
-ROS 2 parameters with descriptors (``haptic_msgs_py.ros.params``), and ``build`` turns a mapping of
-parameter values (a node's parameters or a ``ros__parameters`` YAML section) back into the
-dataclass, so a node and a batch run read the same names, defaults and limits.
+choices, read-only). ``specs_of`` turns the fields into ``ParamSpec`` rows; nodes declare them
+as ROS 2 parameters with descriptors (``haptic_dob.runtime.ros.params``), and ``build`` turns a
+mapping of parameter values (a node's parameters or a ``ros__parameters`` YAML section) back into
+the dataclass, so a node and a batch run read the same names, defaults and limits.
 """
 
 from __future__ import annotations

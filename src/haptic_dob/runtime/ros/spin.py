@@ -35,9 +35,9 @@ from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 from rclpy.time import Time
 
+from haptic_dob.runtime.cpu_latency import NO_REQUEST, hold, strictest
+from haptic_dob.runtime.cpus import checked_cpus, pin_process
 from haptic_msgs_py.bus import bus_for
-from haptic_msgs_py.cpu_latency import NO_REQUEST, hold, strictest
-from haptic_msgs_py.cpus import checked_cpus, pin_process
 
 EXECUTORS = ("events", "single")
 DRAIN_BUDGET_S = 2.0  # at most this long for the work-off and the acknowledgements at a stop

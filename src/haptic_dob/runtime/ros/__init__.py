@@ -1,0 +1,1 @@
+"""The runtime parts that need rclpy: the spin loop, the ROS parameter table, diagnostics."""
