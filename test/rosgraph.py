@@ -20,6 +20,8 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from waits import wait_until
+
 BIN = Path(sys.executable).parent
 
 
@@ -171,12 +173,7 @@ class Collector:
 
     def wait_for(self, topic: str, n: int, timeout: float) -> bool:
         """Wait until ``n`` messages of ``topic`` arrived (False on timeout)."""
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            if self.count(topic) >= n:
-                return True
-            time.sleep(0.02)
-        return self.count(topic) >= n
+        return wait_until(lambda: self.count(topic) >= n, timeout, poll_s=0.02)
 
     def newest_stamp_ns(self, topic: str) -> int | None:
         """Header stamp (ns) of the last message of a Header-first ``topic`` (little-endian CDR)."""
@@ -192,14 +189,12 @@ class Collector:
 
         Reliable readers get one writer's messages in order, so the newest tells.
         """
-        end = time.monotonic() + timeout
-        while True:
+
+        def arrived() -> bool:
             newest = self.newest_stamp_ns(topic)
-            if newest is not None and newest >= stamp_ns:
-                return True
-            if time.monotonic() >= end:
-                return False
-            time.sleep(0.02)
+            return newest is not None and newest >= stamp_ns
+
+        return wait_until(arrived, timeout, poll_s=0.02)
 
     def messages(self, topic: str) -> list[Any]:
         """The decoded (rosbags) messages of ``topic`` received so far."""
@@ -322,9 +317,12 @@ def switch(env: dict[str, str], mode: str, within: float = 30.0) -> tuple[bool, 
     In OL the observer is off the lockstep critical path: on a loaded machine it may lag more than
     the controller's warm window, and the switch is then refused (as designed) until it catches up.
     """
-    end = time.monotonic() + within
-    while True:
-        ok, reason = set_parameter(env, "controller_node", "mode", mode)
-        if ok or "not flowing" not in reason or time.monotonic() > end:
-            return ok, reason
-        time.sleep(0.5)
+    answer: tuple[bool, str] = (False, "")
+
+    def answered() -> bool:
+        nonlocal answer
+        answer = set_parameter(env, "controller_node", "mode", mode)
+        return answer[0] or "not flowing" not in answer[1]
+
+    wait_until(answered, within, poll_s=0.5)
+    return answer

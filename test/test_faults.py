@@ -24,6 +24,7 @@ from haptic_msgs_py.stamps import command_stamp, stamp_ns
 from haptic_msgs_py.topics import DIAGNOSTICS, EFFORT_COMMAND, JOINT_STATES, SESSION_TOPICS
 from recorded import assert_received_written_in_bag, bag_stamps
 from rosgraph import Collector, Process, isolated_env, restart, start_nodes, stop_all
+from waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -116,13 +117,12 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
     procs = start_nodes(config, env, sets, tmp_path, groups=[others(victim)])
     try:
         # the loop runs: the hand pushes into the wall, the effort is the wall's push-back
-        deadline = time.monotonic() + 40
-        while time.monotonic() < deadline:
+
+        def pushing() -> bool:
             _, _, e = efforts(col)
-            if e.size > 500 and np.all(np.abs(e[-200:]) > 0.1):
-                break
-            time.sleep(0.2)
-        else:
+            return bool(e.size > 500 and np.all(np.abs(e[-200:]) > 0.1))
+
+        if not wait_until(pushing, 40, poll_s=0.2):
             pytest.fail("the loop did not close: " + procs["device_node"].output()[-2000:])
         t_kill = time.monotonic()
         os.kill(procs[victim].proc.pid, signal.SIGKILL)
@@ -131,14 +131,9 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         # loaded machine; a fixed sleep is not enough)
         _, stamps, _ = efforts(col)
         stamp_at_kill = stamps[-1]
-        deadline = time.monotonic() + 20
-        while time.monotonic() < deadline:
-            t, stamps, e = efforts(col)
-            if stamps[-1] > stamp_at_kill + 0.5:
-                break
-            time.sleep(0.2)
-        else:
+        if not wait_until(lambda: efforts(col)[1][-1] > stamp_at_kill + 0.5, 20, poll_s=0.2):
             pytest.fail("the device's samples stopped coming after the kill")
+        t, stamps, e = efforts(col)
         before = t < t_kill
         after = ~before
         # the force is zero from some sample after the kill to the end (the node stays dead)
@@ -165,23 +160,18 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         assert latency <= TIMEOUT_S + 2 * PERIOD_S + 1e-9, f"{latency * 1e3:.1f} ms"
         # diagnostics come once a second; on one loaded core the collector may take a while to
         # see them (a guard against hanging, not a bound on the node)
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            statuses = diagnostics_after(col, t_kill)
-            if any(reason in s for s in statuses):
-                break
-            time.sleep(0.2)
+        wait_until(lambda: any(reason in s for s in diagnostics_after(col, t_kill)), 30, poll_s=0.2)
+        statuses = diagnostics_after(col, t_kill)
         assert any(reason in s for s in statuses), statuses
         # bring the node back: the force comes back
         t_restart = time.monotonic()
         restart(procs, victim, env, tmp_path, config, sets)
-        deadline = time.monotonic() + 40
-        while time.monotonic() < deadline:
+
+        def resumed() -> bool:
             t, _, e = efforts(col)
-            if np.sum(np.abs(e[t > t_restart]) > 0.1) > 200:
-                break
-            time.sleep(0.2)
-        else:
+            return bool(np.sum(np.abs(e[t > t_restart]) > 0.1) > 200)
+
+        if not wait_until(resumed, 40, poll_s=0.2):
             pytest.fail(f"the loop did not resume after restarting {victim}")
         # ... and keeps coming (a snapshot of the last samples could fall in a watchdog trip
         # when this loaded machine stalls a process for more than the 5 ms command timeout)
@@ -194,13 +184,12 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
 
 def wait_for_effort(col: Collector, since: float, n: int, timeout: float) -> bool:
     """``n`` samples with a pushing effort (> 0.1 N) arrived after ``since`` (monotonic s)."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
+
+    def enough() -> bool:
         t, _, e = efforts(col)
-        if np.sum(np.abs(e[t > since]) > 0.1) >= n:
-            return True
-        time.sleep(0.2)
-    return False
+        return bool(np.sum(np.abs(e[t > since]) > 0.1) >= n)
+
+    return wait_until(enough, timeout, poll_s=0.2)
 
 
 def test_a_bag_recorded_across_a_node_kill_is_readable_and_analysable(root, tmp_path) -> None:

@@ -19,6 +19,7 @@ from haptic_msgs_py.ros.raw import RawPublisher
 from haptic_msgs_py.stamps import stamp_ns
 from haptic_msgs_py.topics import JOINT_STATES, SESSION_TOPICS, WRENCH_ESTIMATE
 from rosgraph import BIN, Collector, Process, isolated_env
+from waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -31,12 +32,12 @@ def test_observer_answers_every_queued_sample_when_stopped(tmp_path) -> None:
     pub = RawPublisher(col.node, SESSION_TOPICS[JOINT_STATES], JOINT_STATES, qos.LOOP)
     observer = Process([str(BIN / "haptic-observer-node")], env, tmp_path / "observer.log")
     try:
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            if pub.get_subscription_count() >= 1 and col.node.count_publishers(WRENCH_ESTIMATE):
-                break
-            time.sleep(0.05)
-        else:
+        if not wait_until(
+            lambda: (
+                pub.get_subscription_count() >= 1 and col.node.count_publishers(WRENCH_ESTIMATE)
+            ),
+            30,
+        ):
             pytest.fail("the observer did not come up: " + observer.output()[-2000:])
         msg = wire.joint_state(["slide"], "")
         msg.velocity = np.zeros(1)
@@ -48,10 +49,7 @@ def test_observer_answers_every_queued_sample_when_stopped(tmp_path) -> None:
             pub.publish(msg)
 
         # sample 0 until it is answered: both ends of both topics matched
-        deadline = time.monotonic() + 30
-        while not col.count(WRENCH_ESTIMATE) and time.monotonic() < deadline:
-            send(0)
-            time.sleep(0.05)
+        wait_until(lambda: col.count(WRENCH_ESTIMATE), 30, check=lambda: send(0))
         assert col.count(WRENCH_ESTIMATE), observer.output()
         # samples keep coming in after the stop signal, as the device's last ones do when the
         # launcher stops the graph: each is answered

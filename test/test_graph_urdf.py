@@ -23,6 +23,7 @@ from haptic_msgs_py.convert import read_force
 from haptic_msgs_py.stamps import stamp_ns
 from rosgraph import BIN, Collector, Process, isolated_env
 from test_urdf import ARM3, GAIN, check_known_force, known_force_run
+from waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -116,13 +117,9 @@ def test_urdf_observer_node_recovers_a_known_tip_force(tmp_path: Path) -> None:
     col = Collector(env, topics)
     feed = Feeder(env)
     try:
-        end = time.monotonic() + 60
-        while not feed.matched() and time.monotonic() < end:
-            time.sleep(0.05)
-        assert feed.matched(), nodes[0].output() + nodes[1].output()
-        while not col.matched() and time.monotonic() < end:  # its estimates are volatile
-            time.sleep(0.05)
-        assert col.matched(), nodes[0].output() + nodes[1].output()
+        assert wait_until(feed.matched, 60), nodes[0].output() + nodes[1].output()
+        # its estimates are volatile
+        assert wait_until(col.matched, 60), nodes[0].output() + nodes[1].output()
 
         def send(k: int) -> None:
             q, qd, tau = samples[k]
@@ -132,10 +129,12 @@ def test_urdf_observer_node_recovers_a_known_tip_force(tmp_path: Path) -> None:
         # sample 0 until both answer: the feeder may match an observer's reader before that
         # reader knows the feeder, and a volatile reader drops what came before (the observer
         # answers a repeated sample again, with the same estimate)
-        while not all(col.newest_stamp_ns(t) is not None for t in topics):
-            assert time.monotonic() < end, "no estimate of sample 0\n" + nodes[1].output()
-            send(0)
-            time.sleep(0.2)
+        assert wait_until(
+            lambda: all(col.newest_stamp_ns(t) is not None for t in topics),
+            60,
+            poll_s=0.2,
+            check=lambda: send(0),
+        ), "no estimate of sample 0\n" + nodes[1].output()
         for k in range(1, len(samples)):
             send(k)
             if k % BATCH == BATCH - 1 or k == len(samples) - 1:  # a few at a time: none is lost

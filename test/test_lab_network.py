@@ -20,6 +20,7 @@ import pytest
 
 from capacity import require_realtime
 from rosgraph import Process, isolated_env
+from waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -71,14 +72,14 @@ def read(csv: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def wait_live(csv: Path, since: float, timeout: float) -> bool:
     """Wait until 300 samples after ``since`` carry a non-zero effort."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if csv.exists() and csv.stat().st_size:
-            t, _, e = read(csv)
-            if np.sum((t > since) & (np.abs(e) > 0.1)) > 300:
-                return True
-        time.sleep(0.3)
-    return False
+
+    def live() -> bool:
+        if not (csv.exists() and csv.stat().st_size):
+            return False
+        t, _, e = read(csv)
+        return bool(np.sum((t > since) & (np.abs(e) > 0.1)) > 300)
+
+    return wait_until(live, timeout, poll_s=0.3)
 
 
 def test_loop_across_two_hosts_and_a_link_failure(hosts, root, tmp_path) -> None:

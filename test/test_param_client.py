@@ -4,7 +4,6 @@ the described type, an integer given for a double is stored as a double (at star
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -19,6 +18,7 @@ from rclpy.parameter_client import AsyncParameterClient
 from haptic_dob.nodes.controller_node import ControllerNode
 from haptic_sim.nodes.device_node import DeviceNode
 from rosgraph import isolated_env
+from waits import wait_until
 
 
 @pytest.fixture
@@ -45,9 +45,8 @@ class Cli:
         assert self.client.wait_for_services(timeout_sec=30.0), "parameter services not found"
 
     def call(self, future: Any) -> Any:
-        end = time.monotonic() + 30.0  # a hang guard, not a timing bound
-        while not future.done() and time.monotonic() < end:
-            self.ex.spin_once(timeout_sec=0.1)
+        # a hang guard, not a timing bound
+        wait_until(future.done, 30.0, step=lambda: self.ex.spin_once(timeout_sec=0.1))
         assert future.done(), "no answer from the parameter service"
         return future.result()
 

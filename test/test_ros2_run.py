@@ -5,13 +5,13 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
-import time
 from pathlib import Path
 
 import pytest
 from ament_index_python.packages import get_package_prefix
 
 from rosgraph import isolated_env
+from waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess]
 
@@ -34,13 +34,12 @@ def node_names(env: dict[str, str]) -> set[str]:
     rclpy.init(context=ctx, args=[])
     try:
         probe = rclpy.create_node("probe", context=ctx)
-        deadline = time.monotonic() + 15
-        names: set[str] = set()
-        while time.monotonic() < deadline:
-            names = {n for n, _ in probe.get_node_names_and_namespaces()}
-            if len(names) > 1:
-                break
-            time.sleep(0.1)
+
+        def names_now() -> set[str]:
+            return {n for n, _ in probe.get_node_names_and_namespaces()}
+
+        wait_until(lambda: len(names_now()) > 1, 15, poll_s=0.1)
+        names = names_now()
         probe.destroy_node()
         return names
     finally:
@@ -107,9 +106,8 @@ def test_ctrl_c_during_start_up_ends_quietly(package: str, name: str, phase: str
         [str(exe)], env=isolated_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT
     )
     try:
-        end = time.monotonic() + 60.0  # a hang guard: the phase comes within the start-up
-        while not _mapped(proc.pid, PHASES[phase]) and time.monotonic() < end:
-            time.sleep(0.002)
+        # a hang guard: the phase comes within the start-up
+        wait_until(lambda: _mapped(proc.pid, PHASES[phase]), 60.0, poll_s=0.002)
         assert proc.poll() is None, "the node ended by itself"
         proc.send_signal(signal.SIGINT)
         out, _ = proc.communicate(timeout=30)  # lost signal: TimeoutExpired
