@@ -48,7 +48,8 @@ def model_yaml(fit: SlideFit, bag: str) -> str:
 
     head = f"# identified from {bag} by haptic-identify ({fit.method}, joint {fit.joint})\n"
     doc = {f"/**/{n}": {"ros__parameters": fit.as_params()} for n in MODEL_NODES}
-    return head + yaml.safe_dump(doc, sort_keys=False)
+    body: str = yaml.safe_dump(doc, sort_keys=False)
+    return head + body
 
 
 def command(

@@ -112,6 +112,7 @@ class DisturbanceObserver:
         self.dls_threshold_m = positive("dls_threshold_m", dls_threshold_m)
         self.dls_damping_m = positive("dls_damping_m", dls_damping_m)
         self._scalar = isinstance(model, SlideModel)
+        self._axis = model.axis if isinstance(model, SlideModel) else np.zeros(3)  # (3,) slide
         self._n = n
         self._eye = np.eye(n)
         # one pass for D(q) and the bias effort when the model offers it (pinocchio models)
@@ -276,7 +277,7 @@ class DisturbanceObserver:
         """End-effector force F_hat (N), (3,), with J(q)^T F_hat = d_hat (damped least squares)."""
         if self._scalar:
             scalar_of("q", q)
-            return self.model.axis * float(self._estimate[0])  # type: ignore[attr-defined]  # the scalar path has a SlideModel
+            return self._axis * float(self._estimate[0])
         J = self.model._jacobian(self._vector("q", q))
         d = self._estimate
         if J.shape == (3, 3):

@@ -23,7 +23,7 @@ def to_ns(sec: int, nanosec: int) -> int:
 def stamp_ns(msg: Any) -> int:
     """Nanoseconds of ``msg.header.stamp`` (works for rclpy and rosbags messages)."""
     st = msg.header.stamp
-    return st.sec * NS_PER_S + st.nanosec
+    return int(st.sec) * NS_PER_S + int(st.nanosec)
 
 
 def period_ns(rate_hz: float) -> int:

@@ -10,7 +10,7 @@ same message classes come out of recorded bags.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from rosbags.typesys import Stores, get_typestore
@@ -44,7 +44,7 @@ def encode(msg: Any) -> bytes:
     return bytes(_serialize(msg, msg.__msgtype__))
 
 
-def decoder(typename: str):
+def decoder(typename: str) -> Callable[[bytes | memoryview], Any]:
     """A one-argument function turning CDR bytes of ``typename`` into a rosbags message."""
 
     def decode(data: bytes | memoryview) -> Any:

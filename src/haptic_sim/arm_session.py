@@ -60,7 +60,8 @@ class ArmSessionConfig:
 
     def replace(self, **groups: Any) -> ArmSessionConfig:
         """A copy with whole groups replaced, or single fields as ``group__field=value``."""
-        return replace_groups(self, **groups)
+        out: ArmSessionConfig = replace_groups(self, **groups)
+        return out
 
     @classmethod
     def from_node_params(cls, nodes: Mapping[str, Mapping[str, Any]]) -> ArmSessionConfig:

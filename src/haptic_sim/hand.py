@@ -137,9 +137,10 @@ def reference_for_force(
 def _band_filter(params: HandParams, dt: float) -> np.ndarray:
     """The reference's band-pass (4th-order Butterworth) at sample period ``dt`` (s)."""
     nyq = 0.5 / dt
-    return signal.butter(
+    sos: np.ndarray = signal.butter(
         4, [params.band_low_hz / nyq, params.band_high_hz / nyq], btype="bandpass", output="sos"
     )
+    return sos
 
 
 class HandReference:

@@ -79,7 +79,8 @@ class SessionConfig:
 
     def replace(self, **groups: Any) -> SessionConfig:
         """A copy with whole groups replaced, or single fields as ``group__field=value``."""
-        return replace_groups(self, **groups)
+        out: SessionConfig = replace_groups(self, **groups)
+        return out
 
     @classmethod
     def from_node_params(cls, nodes: Mapping[str, Mapping[str, Any]]) -> SessionConfig:

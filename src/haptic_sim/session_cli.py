@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 from haptic_dob.cli import ArgumentParser, run
 from haptic_dob.configs import resolve_config
@@ -68,7 +69,7 @@ def run_arm(
     duration: float | None,
     seed: int | None,
     save: str | None,
-) -> dict:
+) -> dict[str, Any]:
     """A PHANToM or URDF-arm session (``haptic_sim.arm_session``) with the same overrides."""
     from haptic_sim.arm_session import ArmSessionConfig, run_arm_session
 
@@ -97,7 +98,7 @@ def run_arm(
     return summary
 
 
-def print_summary(summary: dict, as_json: bool) -> None:
+def print_summary(summary: dict[str, Any], as_json: bool) -> None:
     """JSON, or one aligned ``key  value`` line per figure."""
     if as_json:
         print(json.dumps(summary, indent=2))

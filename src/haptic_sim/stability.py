@@ -29,6 +29,7 @@ import itertools
 import math
 from concurrent.futures import Executor, ProcessPoolExecutor
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -123,7 +124,7 @@ class StabilitySweep:
     onset_stiffness_n_per_m: float | None = None
     theory_bound_n_per_m: float = math.nan
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """JSON-ready summary (``controller``, ``kf``, ``onset_stiffness_n_per_m`` ...)."""
 
         def num(x: float | None) -> float | None:

@@ -219,7 +219,9 @@ def plot_wall(
 
 
 # --- the whole reproduction -------------------------------------------------------------------
-def reproduce_free_motion(out_dir: Path | None, setup: Setup = Setup(), duration_s: float = 3.0):
+def reproduce_free_motion(
+    out_dir: Path | None, setup: Setup = Setup(), duration_s: float = 3.0
+) -> dict[str, Any]:
     """Run 5.2.1; write ``thesis_5_2_1.png`` to ``out_dir`` (if given); return the numbers."""
     result = free_motion(setup, duration_s)
     errors = free_motion_errors(result)

@@ -204,7 +204,8 @@ class PinocchioModel(DeviceModel):
         elif model.nv != self.dof:
             raise ValueError(f"the pinocchio model has {model.nv} joints, names give {self.dof}")
         self._S = S
-        self._St = None if S is None else np.ascontiguousarray(S.T)
+        # S^T (unused without a selection: empty, so the type stays an array)
+        self._St: Mat = np.empty((0, 0)) if S is None else np.ascontiguousarray(S.T)
         self._zero_t = np.zeros(model.nv)
         visc = np.asarray(viscous, dtype=np.float64)
         visc = (
@@ -236,24 +237,24 @@ class PinocchioModel(DeviceModel):
     # --- DeviceModel ---------------------------------------------------------------------------
     def _mass_matrix(self, q: Vec) -> Mat:
         m, d, S = self._model, self._data, self._S
-        if S is None:
-            return pin.crba(m, d, q).copy()
-        return self._St @ pin.crba(m, d, S @ q) @ S
+        M: Mat = pin.crba(m, d, q if S is None else S @ q)
+        return M.copy() if S is None else self._St @ M @ S
 
     def _rnea(self, q: Vec, qd: Vec) -> Vec:
         m, d, S = self._model, self._data, self._S
         if S is None:
-            return pin.rnea(m, d, q, qd, self._zero_t).copy()
-        return self._St @ pin.rnea(m, d, S @ q, S @ qd, self._zero_t)
+            h: Vec = pin.rnea(m, d, q, qd, self._zero_t)
+            return h.copy()
+        hs: Vec = pin.rnea(m, d, S @ q, S @ qd, self._zero_t)
+        return self._St @ hs
 
     def _coriolis_vector(self, q: Vec, qd: Vec) -> Vec:
         return self._rnea(q, qd) - self._gravity(q)
 
     def _gravity(self, q: Vec) -> Vec:
         m, d, S = self._model, self._data, self._S
-        if S is None:
-            return pin.computeGeneralizedGravity(m, d, q).copy()
-        return self._St @ pin.computeGeneralizedGravity(m, d, S @ q)
+        g: Vec = pin.computeGeneralizedGravity(m, d, q if S is None else S @ q)
+        return g.copy() if S is None else self._St @ g
 
     def _friction(self, qd: Vec) -> Vec:
         return self.viscous * qd
@@ -266,14 +267,14 @@ class PinocchioModel(DeviceModel):
 
     def _jacobian(self, q: Vec) -> Mat:
         m, d, S = self._model, self._data, self._S
-        if S is None:
-            return pin.computeFrameJacobian(m, d, q, self._fid, _LWA)[:3].copy()
-        return pin.computeFrameJacobian(m, d, S @ q, self._fid, _LWA)[:3] @ S
+        J: Mat = pin.computeFrameJacobian(m, d, q if S is None else S @ q, self._fid, _LWA)[:3]
+        return J.copy() if S is None else J @ S
 
     def _forward_kinematics(self, q: Vec) -> Vec:
         m, d, S = self._model, self._data, self._S
         pin.forwardKinematics(m, d, q if S is None else S @ q)
-        return pin.updateFramePlacement(m, d, self._fid).translation.copy()
+        x: Vec = pin.updateFramePlacement(m, d, self._fid).translation.copy()
+        return x
 
     def _tip_state(self, q: Vec, qd: Vec) -> tuple[Vec, Mat, Vec]:
         """End-effector point p (m), linear Jacobian J (3, dof) and ``J' q'`` (m/s^2).

@@ -14,9 +14,11 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import Enum
-from typing import Any
+from typing import Any, TypeVar
 
 ParamValue = bool | int | float | str | list[float] | list[str]
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -168,7 +170,7 @@ def specs_of(cls: type, prefix: str = "", read_only: bool | None = None) -> list
     return out
 
 
-def build(cls: type, values: Mapping[str, Any], prefix: str = "") -> Any:
+def build(cls: type[T], values: Mapping[str, Any], prefix: str = "") -> T:
     """Instantiate settings dataclass ``cls`` from ``values`` (keys ``prefix + field``).
 
     Missing keys keep the dataclass defaults; arrays become tuples. Raises ``ValueError`` with the

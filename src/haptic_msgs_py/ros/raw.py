@@ -20,7 +20,8 @@ from haptic_msgs_py.wire import decoder, encode
 def rclpy_type(typename: str) -> type:
     """The rclpy message class of ``pkg/msg/Name``."""
     pkg, _, name = typename.split("/")
-    return getattr(importlib.import_module(f"{pkg}.msg"), name)
+    cls: type = getattr(importlib.import_module(f"{pkg}.msg"), name)
+    return cls
 
 
 class RawPublisher:

@@ -34,6 +34,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 from rclpy.time import Time
+from rclpy.utilities import try_shutdown
 
 from haptic_dob.runtime.cpu_latency import NO_REQUEST, hold, strictest
 from haptic_dob.runtime.cpus import checked_cpus, pin_process
@@ -150,7 +151,7 @@ def hold_asked_cpu_latency(nodes: Sequence[Node]) -> int | None:
 def make_executor(kind: str, context: Context) -> Executor:
     """``events`` (rclpy.experimental.EventsExecutor, the default) or ``single``."""
     if kind == "events":
-        from rclpy.experimental import EventsExecutor
+        from rclpy.experimental.events_executor import EventsExecutor
 
         return EventsExecutor(context=context)
     if kind == "single":
@@ -254,7 +255,7 @@ def run_nodes(
     finally:
         for n in nodes:
             n.destroy_node()
-        rclpy.try_shutdown(context=context)
+        try_shutdown(context=context)
         if latency_fd is not None:  # the request ends with the loop
             os.close(latency_fd)
         for s, h in old.items():
