@@ -162,17 +162,9 @@ def run_arm_session(config: ArmSessionConfig, cycles: int | None = None) -> ArmS
     """Run ``config`` in-process for ``cycles`` cycles (default: duration_s * rate_hz)."""
     loop = config.loop
     device = SimulatedArm(
-        config.plant,
-        config.device,
-        config.sensor,
-        config.hand,
-        loop.rate_hz,
-        loop.substeps,
-        loop.seed,
+        config.plant, config.device, config.sensor, config.hand, *loop.device_args()
     )
-    n = round(loop.duration_s * loop.rate_hz) if cycles is None else int(cycles)
-    if n <= 0:
-        raise ValueError(f"a batch session needs at least one cycle, got {n}")
+    n = loop.batch_cycles(cycles)
     obs_model = config.observer_model or config.plant
     if obs_model.dof != device.dof:
         raise ValueError(f"observer model has {obs_model.dof} joints, the plant {device.dof}")

@@ -41,9 +41,7 @@ def build_device(values: Mapping[str, Any]) -> SimulatedSlide | SimulatedArm:
             build(SlideDeviceParams, values, "plant."),
             build(ForceSensorParams, values, "sensor."),
             build(HandParams, values, "hand."),
-            loop.rate_hz,
-            loop.substeps,
-            loop.seed,
+            *loop.device_args(),
         )
     if kind in ("phantom", "urdf"):
         return SimulatedArm(
@@ -51,8 +49,6 @@ def build_device(values: Mapping[str, Any]) -> SimulatedSlide | SimulatedArm:
             build(ArmDeviceParams, values, "arm."),
             build(ForceSensorParams, values, "sensor."),
             build(HandParams, values, "hand."),
-            loop.rate_hz,
-            loop.substeps,
-            loop.seed,
+            *loop.device_args(),
         )
     raise ValueError(f"device_node simulates model slide, phantom or urdf, got {kind!r}")

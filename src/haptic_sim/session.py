@@ -57,6 +57,17 @@ class LoopSettings:
         if self.substeps < 1:
             raise ValueError(f"substeps must be >= 1, got {self.substeps}")
 
+    def batch_cycles(self, cycles: int | None = None) -> int:
+        """The cycles a batch run takes: ``cycles``, or ``duration_s * rate_hz`` (at least 1)."""
+        n = round(self.duration_s * self.rate_hz) if cycles is None else int(cycles)
+        if n <= 0:
+            raise ValueError(f"a batch session needs at least one cycle, got {n}")
+        return n
+
+    def device_args(self) -> tuple[float, int, int]:
+        """(rate_hz, substeps, seed): the loop's part of a simulated device's arguments."""
+        return self.rate_hz, self.substeps, self.seed
+
 
 @dataclass(frozen=True)
 class SessionConfig:
@@ -193,17 +204,9 @@ def run_session(config: SessionConfig, cycles: int | None = None) -> SessionResu
     """Run ``config`` in-process for ``cycles`` cycles (default: duration_s * rate_hz)."""
     loop = config.loop
     device = SimulatedSlide(
-        config.model,
-        config.device,
-        config.sensor,
-        config.hand,
-        loop.rate_hz,
-        loop.substeps,
-        loop.seed,
+        config.model, config.device, config.sensor, config.hand, *loop.device_args()
     )
-    n = round(loop.duration_s * loop.rate_hz) if cycles is None else int(cycles)
-    if n <= 0:
-        raise ValueError(f"a batch session needs at least one cycle, got {n}")
+    n = loop.batch_cycles(cycles)
     obs_model = (config.observer_model or config.model).model()
     observer = config.observer.build(obs_model, device.dt)
     cycle = LoopCycle(
