@@ -2,9 +2,8 @@
 
 Between two messages of a cycle a node process sleeps, and so does its CPU when nothing else runs
 there. Waking a CPU from a deep idle state takes time, and on a virtual machine much more: a
-halted virtual CPU waits for the host to schedule it again. A trace of the 4-process graph on
-the 2-core virtual machine of BENCHMARKS.md showed a hand-over of about 300 us to an idle CPU
-where about 130 us is usual. Writing a latency bound in microseconds to ``/dev/cpu_dma_latency``
+halted virtual CPU waits for the host to schedule it again (BENCHMARKS.md measures the hand-over
+with and without the request). Writing a latency bound in microseconds to ``/dev/cpu_dma_latency``
 and keeping the file open asks the kernel to use only idle states whose advertised exit latency
 is within that bound (0: the CPU polls instead of sleeping; a virtual machine's halt state
 advertises about 1 us, however long the host takes, so there only 0 helps); closing it, or the

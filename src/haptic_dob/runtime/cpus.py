@@ -4,8 +4,8 @@ A lockstep cycle is a chain device -> environment -> controller -> device, with 
 beside it. On a 2-core machine the scheduler moves the four processes between the cores at every
 hand-over, and each move costs the process its warm caches. Pinning the device and the controller
 (which never run at the same time in a cycle) to one CPU and the environment and the observer to
-the other keeps every process on warm caches: the measured lockstep real-time factor goes from
-about 1.9 to about 2.5 on the 2-core machine of BENCHMARKS.md. As in ros2_control's controller
+the other keeps every process on warm caches (BENCHMARKS.md, "pinned", measures what it gains).
+As in ros2_control's controller
 manager (its ``cpu_affinity`` parameter), pinning is asked for, never the default: a pinned process
 cannot move away from a core that other work occupies.
 """
