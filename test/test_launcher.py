@@ -7,6 +7,7 @@ import os
 import signal
 import subprocess
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,8 @@ import pytest
 from conftest import can_request_cpu_latency, tool
 from haptic_msgs_py.topics import JOINT_STATES, SESSION_TOPICS
 from haptic_sim.session import SessionConfig, run_session
-from rosgraph import Collector, isolated_env, launch
+from rosgraph import Collector, Process, isolated_env, launch
+from waits import wait_until
 
 #: executable (as in a node's command line) -> node name
 NODE_NAMES = {
@@ -24,18 +26,21 @@ NODE_NAMES = {
     "haptic-observer-node": "observer_node",
     "haptic-controller-node": "controller_node",
 }
-NODE_EXES = (
-    "haptic-device-node",
-    "haptic-environment-node",
-    "haptic-observer-node",
-    "haptic-controller-node",
-)
 
 
 def children_of(pid: int) -> list[int]:
     """PIDs whose parent is ``pid``."""
     out = subprocess.run(["ps", "-o", "pid=", "--ppid", str(pid)], capture_output=True, text=True)
     return [int(p) for p in out.stdout.split()]
+
+
+def running(graph: Process, log: Path) -> Callable[[], None]:
+    """A ``check`` for ``wait_until``: fails the test, with the log, once ``graph`` has ended."""
+
+    def check() -> None:
+        assert graph.proc.poll() is None, log.read_text()
+
+    return check
 
 
 def alive(pid: int) -> bool:
@@ -75,12 +80,14 @@ def test_signal_to_the_launcher_stops_every_node_cleanly(
         stdout=out,
         stderr=subprocess.STDOUT,
     )
+    kids: list[int] = []
+
+    def started() -> list[int]:
+        found = children_of(proc.pid)
+        return found if len(found) >= processes else []
+
     try:
-        deadline = time.monotonic() + 30
-        kids: list[int] = []
-        while time.monotonic() < deadline and len(kids) < processes:
-            kids = children_of(proc.pid)
-            time.sleep(0.2)
+        kids = wait_until(started, 30, poll_s=0.2)
         assert len(kids) == processes, log.read_text()
         time.sleep(2.0)  # let the loop run
         proc.send_signal(sig)
@@ -211,25 +218,6 @@ def test_record_option_writes_a_complete_bag(root, tmp_path) -> None:
     assert again.returncode == 2 and "exists already" in again.stderr
 
 
-@pytest.mark.parametrize(
-    ("given", "expected"),
-    [("", ""), ("slide1", "/slide1"), ("/slide1", "/slide1"), ("lab/slide_1/", "/lab/slide_1")],
-)
-def test_namespace_is_made_absolute(given: str, expected: str) -> None:
-    from haptic_dob.launcher import normalize_namespace
-
-    assert normalize_namespace(given) == expected
-
-
-@pytest.mark.parametrize("bad", ["1slide", "sl ide", "a//b", "a-b"])
-def test_invalid_namespace_is_refused(bad: str) -> None:
-    from haptic_dob.cli import CliError
-    from haptic_dob.launcher import normalize_namespace
-
-    with pytest.raises(CliError, match="not a valid ROS namespace"):
-        normalize_namespace(bad)
-
-
 def test_rt_priority_without_permission_is_one_line(monkeypatch) -> None:
     from haptic_dob.cli import CliError
     from haptic_dob.launcher import set_rt_priority
@@ -276,10 +264,12 @@ def test_pin_runs_each_node_process_on_its_planned_cpu(root, tmp_path) -> None:
         ["--pin", "--processes"],
     )
     try:
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and log.read_text().count("process pinned") < 4:
-            assert proc.proc.poll() is None, log.read_text()
-            time.sleep(0.2)
+        wait_until(
+            lambda: log.read_text().count("process pinned") >= 4,
+            60,
+            poll_s=0.2,
+            check=running(proc, log),
+        )
         text = log.read_text()
         assert text.count("process pinned") == 4, text
         kids = children_of(proc.proc.pid)
@@ -328,10 +318,12 @@ def test_cpu_latency_is_held_while_the_graph_runs_and_withdrawn_after(tmp_path) 
         ["--cpu-latency", "0", "--processes"],
     )
     try:
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and log.read_text().count("held at 0 us") < 4:
-            assert proc.proc.poll() is None, log.read_text()
-            time.sleep(0.2)
+        wait_until(
+            lambda: log.read_text().count("held at 0 us") >= 4,
+            60,
+            poll_s=0.2,
+            check=running(proc, log),
+        )
         text = log.read_text()
         for name in NODE_NAMES.values():
             assert f"[{name}]: CPU wake-up latency held at 0 us" in text, text
@@ -358,67 +350,6 @@ def test_a_graph_stopped_while_its_nodes_start_stops_quietly() -> None:
     out = launch_cli("slide_sim", "--duration", "0.05")
     assert out.returncode == 0, out.stderr
     assert "Traceback" not in out.stderr and "did not stop" not in out.stderr, out.stderr
-
-
-def test_pin_on_one_cpu_is_one_line(monkeypatch) -> None:
-    from haptic_dob import launcher
-    from haptic_dob.cli import CliError
-    from haptic_dob.runtime import cpus
-
-    monkeypatch.setattr(cpus, "available_cpus", lambda: [0])
-    with pytest.raises(CliError, match="--pin: pinning needs at least 2 CPUs"):
-        launcher.add_pinning({"device_node": {}, "controller_node": {}})
-
-
-@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="--pin needs 2 CPUs")
-def test_pin_keeps_an_affinity_the_config_gives() -> None:
-    from haptic_dob.launcher import add_pinning
-
-    params = {"/**": {}, "device_node": {"cpu_affinity": [1]}, "environment_node": {}}
-    assert "device_node: 1" in add_pinning(params)
-    assert params["device_node"]["cpu_affinity"] == [1]
-    assert params["environment_node"]["cpu_affinity"] and "cpu_affinity" not in params["/**"]
-    common = {"/**": {"cpu_affinity": [0]}, "device_node": {}, "observer_node": {}}
-    assert add_pinning(common) == "device_node: 0, observer_node: 0"  # every node's, kept
-    assert "cpu_affinity" not in common["device_node"]
-
-
-@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="--pin needs 2 CPUs")
-@pytest.mark.parametrize("given", [1, "0", True])
-def test_pin_refuses_a_cpu_affinity_that_is_no_list(given) -> None:
-    from haptic_dob.cli import CliError
-    from haptic_dob.launcher import add_pinning
-
-    with pytest.raises(CliError, match="cpu_affinity of device_node must be a list of CPU"):
-        add_pinning({"device_node": {"cpu_affinity": given}})
-
-
-def test_the_loop_shares_a_process_by_default_and_a_recorder_runs_apart(root, tmp_path) -> None:
-    from haptic_dob.launcher import add_recorder, groups_for, plan, resolved_params
-
-    params = resolved_params(root / "config" / "slide_sim.yaml", {})
-    add_recorder(params, str(tmp_path / "bag"), "mcap")
-    names = [n for n in params if n != "/**"]
-    loop = ["environment_node", "observer_node", "controller_node", "device_node"]
-    specs = plan(params, tmp_path / "p.yaml", "/ns", groups_for(names, False, False, ()))
-    assert [s.nodes for s in specs] == [["recorder_node"], loop]
-    station = specs[1]
-    assert Path(station.executable).parts[-3:] == ("lib", "haptic_dob", "container")
-    assert station.args[:4] == loop and "__ns:=/ns" in station.args
-    assert not any(a.startswith("__node:=") for a in station.args)  # the nodes keep their names
-    assert station.label == "the process of " + ", ".join(loop)
-    alone = plan(params, tmp_path / "p.yaml", "", groups_for(names, False, True, ()))
-    assert [s.nodes for s in alone] == [[n] for n in ["recorder_node", *loop]]
-    assert all(f"__node:={s.name}" in s.args for s in alone)
-    pairs = groups_for(names, False, False, ["device_node,controller_node"])
-    assert [s.nodes for s in plan(params, tmp_path / "p.yaml", "", pairs)] == [
-        ["recorder_node"],
-        ["environment_node"],
-        ["observer_node"],
-        ["controller_node", "device_node"],
-    ]
-    everything = plan(params, tmp_path / "p.yaml", "", groups_for(names, True, False, ()))
-    assert [s.nodes for s in everything] == [["recorder_node", *loop]]
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,8 @@
+"""``python -m haptic_dob.launcher``: the same as ``haptic-launch``."""
+
+import sys
+
+from haptic_dob.launcher.cli import main
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,87 @@
+"""The nodes' parameter table of one launch: the config's node sections with ``--set`` applied,
+what ``--record``, ``--pin`` and ``--cpu-latency`` add, and the params file every node reads.
+
+The table maps a node's name (or ``/**``, every node) to its flat ``{param: value}``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from haptic_dob.cli import CliError
+from haptic_dob.nodes.registry import NODES
+from haptic_dob.runtime.params import load_node_params
+
+
+def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """The config's node sections (flattened, ``--set`` applied), keyed by node name."""
+    out = load_node_params(config)
+    unknown = [n for n in out if n != "/**" and n not in NODES]
+    if unknown:
+        raise CliError(
+            f"{config} names unknown node(s) {', '.join(unknown)}; known: {', '.join(NODES)}"
+        )
+    for node, values in sets.items():
+        out.setdefault(node, {}).update(values)
+    return out
+
+
+def add_recorder(params: dict[str, Any], output: str, storage: str) -> None:
+    """A ``recorder_node`` writing ``output``, and the device waiting for it (loses nothing)."""
+    if Path(output).exists():
+        raise CliError(f"--record {output}: it exists already; the recorder never overwrites a bag")
+    params.setdefault("recorder_node", {}).update(output=output, storage=storage)
+    device = params.setdefault("device_node", {})
+    wait = list(device.get("wait_for", ["environment_node", "observer_node", "controller_node"]))
+    if "recorder_node" not in wait:
+        device["wait_for"] = [*wait, "recorder_node"]
+
+
+def add_pinning(params: dict[str, Any]) -> str:
+    """``--pin``: each loop node's ``cpu_affinity`` from the critical-path placement
+    (``haptic_dob.runtime.cpus``), unless the config (its node section or ``/**``) or ``--set`` gave
+    one; returns the plan's text."""
+    from haptic_dob.runtime.cpus import available_cpus, describe, placement
+
+    try:
+        assigned = placement([n for n in params if n != "/**"], available_cpus())
+    except ValueError as exc:
+        raise CliError(f"--pin: {exc}") from None
+    common = params.get("/**", {}).get("cpu_affinity")
+    for name, cpus in assigned.items():
+        given = params[name].get("cpu_affinity", common)
+        if given is not None and not isinstance(given, list):
+            raise CliError(f"cpu_affinity of {name} must be a list of CPU numbers, got {given!r}")
+        if given:
+            assigned[name] = given
+        else:
+            params[name]["cpu_affinity"] = cpus
+    return describe(assigned)
+
+
+def add_cpu_latency(params: dict[str, Any], latency_us: int) -> None:
+    """``--cpu-latency``: each loop node's ``cpu_latency_us``, unless the config or ``--set``
+    gave a request (its node section or ``/**``; -1, no request, counts as not given)."""
+    from haptic_dob.runtime.cpu_latency import NO_REQUEST
+    from haptic_dob.runtime.cpus import PAIRS
+
+    if not 0 <= latency_us <= 1_000_000:
+        raise CliError(f"--cpu-latency {latency_us}: must be 0 to 1000000 us (0: idle CPUs poll)")
+    common = params.get("/**", {}).get("cpu_latency_us")
+    for name in (n for pair in PAIRS for n in pair if n in params):
+        if params[name].get("cpu_latency_us", common) in (None, NO_REQUEST):
+            params[name]["cpu_latency_us"] = latency_us
+
+
+def write_params_file(params: dict[str, Any], directory: Path) -> Path:
+    """A ``ros__parameters`` file any namespace matches (``/**/<node>`` keys), for this launch."""
+    doc = {}
+    for name, values in params.items():
+        key = "/**" if name == "/**" else f"/**/{name}"
+        doc[key] = {"ros__parameters": values}
+    path = directory / "params.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
+    return path

@@ -1,0 +1,90 @@
+"""What ``haptic-launch`` is asked for (``LaunchOptions``) and the checks that turn option values
+into launch inputs: the namespace, the ``--set`` overrides, the discovery environment."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import yaml
+
+from haptic_dob.cli import CliError
+from haptic_dob.nodes.registry import NODES
+
+
+@dataclass(frozen=True)
+class LaunchOptions:
+    """What ``haptic-launch`` was asked for (its command line, parsed); times in s."""
+
+    config: str
+    namespace: str = ""
+    sets: Sequence[str] = ()
+    composed: bool = False
+    processes: bool = False
+    groups: Sequence[str] = ()
+    stop_timeout: float = 5.0
+    duration: float | None = None
+    executor: str | None = None
+    only: Sequence[str] = ()
+    network: str = "localhost"
+    peers: Sequence[str] = ()
+    record: str | None = None
+    record_storage: str = "mcap"
+    rt_priority: int | None = None
+    pin: bool = False
+    cpu_latency_us: int | None = None
+
+
+def comma_list(text: str) -> tuple[str, ...]:
+    """``a,b,`` -> ``("a", "b")`` (``--only``, ``--peers``): empty items dropped."""
+    return tuple(item for item in text.split(",") if item)
+
+
+def normalize_namespace(namespace: str) -> str:
+    """``slide1`` -> ``/slide1`` (ROS wants it absolute); ``CliError`` for an invalid name."""
+    ns = namespace.strip()
+    if not ns:
+        return ""
+    ns = "/" + ns.strip("/")
+    if not re.fullmatch(r"(/[A-Za-z_][A-Za-z0-9_]*)+", ns):
+        raise CliError(
+            f"--namespace {namespace!r} is not a valid ROS namespace (letters, digits and _ "
+            "separated by /, each part not starting with a digit)"
+        )
+    return ns
+
+
+def parse_sets(items: Sequence[str]) -> dict[str, dict[str, Any]]:
+    """``NODE:PARAM=VALUE`` (VALUE in YAML syntax) -> {node: {param: value}}."""
+    out: dict[str, dict[str, Any]] = {}
+    for item in items:
+        node, sep, assignment = item.partition(":")
+        param, eq, text = assignment.partition("=")
+        if not (sep and eq and node and param):
+            raise CliError(f"--set needs NODE:PARAM=VALUE, got {item!r}")
+        if node not in NODES:
+            raise CliError(f"--set names unknown node {node!r}; nodes: {', '.join(NODES)}")
+        try:
+            value = yaml.safe_load(text)
+        except yaml.YAMLError:
+            raise CliError(f"--set {item!r}: the value is not valid YAML") from None
+        out.setdefault(node, {})[param] = value
+    return out
+
+
+#: ``--network`` -> ``ROS_AUTOMATIC_DISCOVERY_RANGE``
+NETWORKS = {"localhost": "LOCALHOST", "subnet": "SUBNET"}
+
+
+def network_env(network: str, peers: Sequence[str]) -> dict[str, str]:
+    """The discovery variables for ``--network`` and ``--peers``."""
+    if network not in NETWORKS:
+        raise CliError(f"--network must be one of {', '.join(NETWORKS)}, got {network!r}")
+    env = {"ROS_AUTOMATIC_DISCOVERY_RANGE": NETWORKS[network]}
+    if peers:
+        if network == "localhost":
+            raise CliError("--peers needs --network subnet (peers are other hosts)")
+        env["ROS_STATIC_PEERS"] = ";".join(peers)
+    return env

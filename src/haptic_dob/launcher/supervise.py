@@ -1,0 +1,126 @@
+"""The launch's processes at run time: the scheduling and wake-up latency they start with, then
+start, watch (a failed node or the device's finished run stops the graph), forward Ctrl-C and
+SIGTERM, and stop them all (the device's first), killing what outlives the stop timeout."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from haptic_dob.cli import CliError
+from haptic_dob.launcher.process_plan import ProcessSpec
+
+RT_PRIORITIES = range(1, 100)  # SCHED_FIFO priorities Linux accepts
+
+
+def set_rt_priority(priority: int) -> None:
+    """Run this process (and the processes and threads it starts) with ``SCHED_FIFO``.
+
+    Raises ``CliError`` with the reason when the system does not allow it.
+    """
+    if priority not in RT_PRIORITIES:
+        raise CliError(f"--rt-priority {priority}: must be 1 to 99 (SCHED_FIFO priorities)")
+    if not hasattr(os, "sched_setscheduler"):
+        raise CliError("--rt-priority: this system has no SCHED_FIFO scheduling (Linux only)")
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except PermissionError as exc:
+        raise CliError(
+            f"--rt-priority {priority}: not permitted ({exc.strerror}); it needs root, "
+            "CAP_SYS_NICE, or an rtprio limit (limits.conf) of at least that priority"
+        ) from None
+
+
+def check_cpu_latency_request(latency_us: int) -> None:
+    """Make the request once and withdraw it: a launch that cannot make it stops before any
+    node starts, with the reason (``CliError``)."""
+    from haptic_dob.runtime.cpu_latency import hold
+
+    try:
+        os.close(hold(latency_us))
+    except ValueError as exc:
+        raise CliError(f"--cpu-latency {latency_us}: {exc}") from None
+
+
+def launch(
+    specs: list[ProcessSpec],
+    stop_timeout: float,
+    duration: float | None,
+    env: dict[str, str] | None = None,
+) -> int:
+    """Start the processes, supervise them, forward signals, stop them all cleanly.
+
+    Returns the exit code: 0 for a stop asked for (a signal, ``duration`` s, the device's
+    finished run), 1 when a process ended by itself otherwise.
+    """
+    stop: list[int] = []
+
+    def on_signal(signum: int, _frame: object) -> None:
+        stop.append(signum)
+
+    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    procs: dict[str, subprocess.Popen[bytes]] = {}
+    labels = {s.name: s.label for s in specs}
+    device = next((s.name for s in specs if "device_node" in s.nodes), None)
+    code = 0
+    try:
+        for spec in specs:
+            procs[spec.name] = subprocess.Popen(
+                [spec.executable, *spec.args],
+                start_new_session=True,
+                env={**os.environ, **(env or {})},
+            )
+        t_end = None if duration is None else time.monotonic() + duration
+        while not stop:
+            done = {n: p.returncode for n, p in procs.items() if p.poll() is not None}
+            if done:
+                name, rc = next(iter(done.items()))
+                if name == device and rc == 0:
+                    print(
+                        "haptic-launch: device_node finished its run; stopping the graph",
+                        file=sys.stderr,
+                    )
+                else:
+                    print(
+                        f"ERROR: {labels[name]} exited with code {rc}; stopping the graph",
+                        file=sys.stderr,
+                    )
+                    code = 1
+                break
+            if t_end is not None and time.monotonic() >= t_end:
+                break
+            time.sleep(0.05)
+    finally:
+        _stop_all(procs, stop_timeout, device)
+        for s, h in old.items():
+            signal.signal(s, h)
+    return code
+
+
+def _stop_all(procs: dict[str, subprocess.Popen[bytes]], timeout: float, first: str | None) -> None:
+    """SIGTERM to every live process (``first``'s first), wait up to ``timeout`` s, then SIGKILL
+    what is left.
+
+    A node that runs handles SIGTERM as Ctrl-C (``run_nodes``); one still importing its modules
+    ends quietly, where SIGINT would print a ``KeyboardInterrupt`` traceback.
+    """
+    order = sorted(procs, key=lambda n: n != first)
+    for name in order:
+        p = procs[name]
+        if p.poll() is None:
+            p.send_signal(signal.SIGTERM)
+    deadline = time.monotonic() + timeout
+    for name in order:
+        p = procs[name]
+        try:
+            p.wait(max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            print(
+                f"haptic-launch: {name} did not stop within {timeout:g} s; killing it",
+                file=sys.stderr,
+            )
+            p.kill()
+            p.wait()
