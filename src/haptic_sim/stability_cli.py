@@ -72,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
     p = ArgumentParser(
         prog="haptic-stability",
         description="Sweep the wall stiffness in batch simulation and report the vibration onset "
-        "(push-and-hold protocol: see the README).",
+        "(push-and-hold protocol: see docs/recording-and-analysis.md).",
     )
     p.add_argument(
         "--controller",

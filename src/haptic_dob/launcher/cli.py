@@ -17,7 +17,7 @@ Network: by default every node's discovery stays on this host
 (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), so a simulated session never reaches a lab network
 by accident. ``--network subnet`` lets them discover across the subnet, ``--peers`` adds named
 hosts (``ROS_STATIC_PEERS``), and ``--only`` starts a subset: the device on one host and the rest
-on another (see the README's lab-network section).
+on another (see docs/running.md, "Lab network and security").
 """
 
 from __future__ import annotations
