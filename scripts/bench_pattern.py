@@ -8,7 +8,8 @@ estimate with the command, which releases the device's next sample, and takes th
 wrench as well (it uses it in CL). The cycle of this graph is
 what DDS and rclpy cost for the pattern with no maths and no node logic: the 4-process lockstep
 cycle compared with (this + the batch cycle) is what the nodes add. Used by
-``benchmarks.py pattern`` and ``margin``.
+``benchmarks.py pattern`` and ``margin``; ``peer_node`` is the process set-up ``bench_hop``
+shares.
 """
 
 from __future__ import annotations
@@ -116,3 +117,12 @@ def pattern_cycle_us(cycles: int = 5000) -> float:
     if cycle is None:
         raise RuntimeError("the message pattern did not turn over")
     return float(cycle)
+
+
+def bench_pattern(repeat: int) -> str:
+    """The loop's message pattern between four processes that do nothing else (µs a cycle)."""
+    cycles = [pattern_cycle_us() for _ in range(repeat)]
+    return (
+        f"cycle median {statistics.median(cycles):.0f} us (runs: "
+        f"{', '.join(f'{c:.0f}' for c in cycles)})"
+    )

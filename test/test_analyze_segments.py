@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from haptic_dob.bag.cdr import decode_vectors
-from haptic_dob.bag.reader import ParamEvent
+from haptic_dob.bag.param_events import ParamEvent
 from haptic_dob.bag.segments import parameter_history, split
 from haptic_msgs_py import wire
 

@@ -5,19 +5,17 @@ with ``F_tip`` the hand's force plus an optional known external force at the end
 
 Integration: ``substeps`` classical Runge-Kutta (RK4) steps per control period (10 at 1 kHz:
 10 kHz), with the actuator effort held over the whole period (zero-order hold), and the hand's
-reference and the external force held over each sub-step. The dynamics come from the model's
-one-pass ``_mass_and_bias`` (pinocchio models) and a linear solve. A torque-free, frictionless run
-of the PHANToM keeps its energy to 9e-13 J over 2 s (kinetic energy up to 0.65 J; test_phantom).
+reference and the external force held over each sub-step. The dynamics come from the model
+(``haptic_sim.arm_dynamics``: one pass for pinocchio models) and a linear solve. A torque-free,
+frictionless run of the PHANToM keeps its energy to 9e-13 J over 2 s (kinetic energy up to
+0.65 J; test_phantom).
 
 Actuators: each joint's effort is saturated on its own. The limits are ``joint_effort_limits``
 when given, else the model's own (a URDF's ``<limit effort>``) when it has them for every joint,
 else ``max_force_n`` times each column norm of J at the start pose (at least 1 cm): the joint
-effort that gives ``max_force_n`` at the tip there. ``max_force_n`` defaults to 8.5 N, the peak
-("maximum exertable") force SensAble specifies for the PHANToM Premium 1.5 at its nominal
-position (continuous force is about 1.4 N); the thesis rounds it to 10 N (section 5.2).
+effort that gives ``max_force_n`` at the tip there (``haptic_sim.arm_params`` gives the defaults).
 
-Encoders: joint angles quantized to ``encoder_resolution_rad`` (default 1.5e-4 rad: SensAble's
-0.03 mm nominal tip resolution over the PHANToM 1.5's ~0.2 m links; 0 = ideal); velocity is the
+Encoders: joint angles quantized to ``encoder_resolution_rad`` (0 = ideal); velocity is the
 backward difference of the encoder readings, as a driver computes it.
 
 Hand (3-D, ``haptic_sim.hand``): a mass ``m_h`` moving with the handle, held by a grip spring and
@@ -35,107 +33,20 @@ reading the total external force on the end effector (hand plus external force).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import cast
 
 import numpy as np
 
-from haptic_dob.models.base import DeviceModel, Mat, Vec
-from haptic_dob.runtime.params import param
-from haptic_dob.validation import nonnegative, positive, unit_vector, vector
+from haptic_dob.models.base import DeviceModel, Vec
+from haptic_dob.validation import positive, unit_vector, vector
+from haptic_sim.arm_dynamics import dynamics_and_tip, mass_and_bias, solve
+from haptic_sim.arm_params import ArmDeviceParams
 from haptic_sim.device import DeviceSample
 from haptic_sim.hand import HandParams, HandReference
 from haptic_sim.sensor import ForceSensor, ForceSensorParams
 
-#: SensAble PHANToM Premium 1.5: maximum exertable force at the nominal position (N)
-PHANTOM_15_PEAK_FORCE_N = 8.5
-#: PHANToM 1.5 joint resolution: 0.03 mm nominal tip resolution over ~0.2 m links (rad)
-PHANTOM_15_ENCODER_RAD = 1.5e-4
-#: where the reported joint velocity comes from
-VELOCITY_SOURCES = ("difference", "exact")
 _ZERO3 = np.zeros(3)
-
-
-def solve(A: Mat, b: Vec) -> Vec:
-    """``A x = b``; a 3x3 system by cofactors in floats (several times faster than LAPACK here)."""
-    if A.shape != (3, 3):
-        return cast(Vec, np.linalg.solve(A, b))
-    (a, b_, c), (d, e, f), (g, h, i) = A.tolist()
-    c00, c01, c02 = e * i - f * h, f * g - d * i, d * h - e * g
-    det = a * c00 + b_ * c01 + c * c02
-    if det == 0.0 or not math.isfinite(det):
-        return cast(Vec, np.linalg.solve(A, b))
-    r = 1.0 / det
-    x0, x1, x2 = b.tolist()
-    return np.array(
-        (
-            (c00 * x0 + (c * h - b_ * i) * x1 + (b_ * f - c * e) * x2) * r,
-            (c01 * x0 + (a * i - c * g) * x1 + (c * d - a * f) * x2) * r,
-            (c02 * x0 + (b_ * g - a * h) * x1 + (a * e - b_ * d) * x2) * r,
-        )
-    )
-
-
-@dataclass(frozen=True)
-class ArmDeviceParams:
-    """The simulated arm's actuators, encoders, start, hand geometry and external force."""
-
-    max_force_n: float = field(
-        default=PHANTOM_15_PEAK_FORCE_N,
-        metadata=param(
-            "tip force the joint limits are derived from (PHANToM 1.5 peak)", "N", 1e-3, 1e4
-        ),
-    )
-    joint_effort_limits: list[float] | tuple[float, ...] = field(
-        default_factory=list,
-        metadata=param("per-joint effort limits; [] = from the model or max_force_n", "N m"),
-    )
-    encoder_resolution_rad: float = field(
-        default=PHANTOM_15_ENCODER_RAD,
-        metadata=param("joint encoder resolution; 0 = ideal", "rad", 0.0, 0.1),
-    )
-    initial_position: list[float] | tuple[float, ...] = field(
-        default_factory=list,
-        metadata=param("joint angles at start; [] = the model's home (PHANToM) or zeros", "rad"),
-    )
-    hand_direction: tuple[float, float, float] = field(
-        default=(0.0, 0.0, -1.0),
-        metadata=param("direction of the hand's push (unit 3-vector, base frame)"),
-    )
-    hand_lateral_amplitude_m: float = field(
-        default=0.0,
-        metadata=param("std of the semi-random hand motion across the push", "m", 0.0, 1.0),
-    )
-    external_force_n: tuple[float, float, float] = field(
-        default=(0.0, 0.0, 0.0),
-        metadata=param("known external force on the end effector (x, y, z)", "N"),
-    )
-    external_force_at_s: float = field(
-        default=0.0, metadata=param("time the external force steps on", "s", 0.0, 1e6)
-    )
-    velocity: str = field(
-        default="difference",
-        metadata=param(
-            "joint velocity reported: backward difference of the encoders, or the exact one",
-            choices=VELOCITY_SOURCES,
-        ),
-    )
-
-    def __post_init__(self) -> None:
-        positive("max_force_n", self.max_force_n)
-        for i, v in enumerate(self.joint_effort_limits):
-            positive(f"joint_effort_limits[{i}]", v)
-        nonnegative("encoder_resolution_rad", self.encoder_resolution_rad)
-        vector("initial_position", list(self.initial_position), len(self.initial_position))
-        unit_vector("hand_direction", self.hand_direction)
-        nonnegative("hand_lateral_amplitude_m", self.hand_lateral_amplitude_m)
-        vector("external_force_n", self.external_force_n, 3)
-        nonnegative("external_force_at_s", self.external_force_at_s)
-        if self.velocity not in VELOCITY_SOURCES:
-            raise ValueError(
-                f"velocity must be one of {', '.join(VELOCITY_SOURCES)}, got {self.velocity!r}"
-            )
 
 
 def _perpendiculars(u: Vec) -> tuple[Vec, Vec]:
@@ -189,12 +100,8 @@ class SimulatedArm:
             q0 = vector("initial_position", list(dev.initial_position), n)
         else:
             q0 = np.array(getattr(model, "home", np.zeros(n)), dtype=np.float64)
-        self._dyn: Callable[[Vec, Vec], tuple[Mat, Vec]] = getattr(
-            model, "_mass_and_bias", None
-        ) or (lambda q, qd: (model._mass_matrix(q), model._bias_effort(q, qd)))
-        self._dyn_tip: Callable[[Vec, Vec], tuple[Mat, Vec, Vec, Mat, Vec]] = (
-            getattr(model, "_dynamics_and_tip", None) or self._dynamics_and_tip_generic
-        )
+        self._dyn = mass_and_bias(model)
+        self._dyn_tip = dynamics_and_tip(model)
         self.effort_limits = self._limits(q0)
         #: actuator saturation per joint (N m or N), the ``SimulatedDevice`` protocol's name
         self.max_effort = tuple(self.effort_limits.tolist())
@@ -286,19 +193,7 @@ class SimulatedArm:
         if own is not None and len(own) == n and all(v > 0.0 for v in own):
             return np.array(own, dtype=np.float64)
         J = self.model._jacobian(q0)
-        return dev.max_force_n * np.maximum(np.linalg.norm(J, axis=0), 0.01)
-
-    def _dynamics_and_tip_generic(self, q: Vec, v: Vec) -> tuple[Mat, Vec, Vec, Mat, Vec]:
-        """D, h, p, J and J' q' for a model without a one-pass method (J' q' by differences)."""
-        m = self.model
-        D, h = self._dyn(q, v)
-        J = m._jacobian(q)
-        speed = float(np.linalg.norm(v))
-        if speed == 0.0:
-            return D, h, m._forward_kinematics(q), J, np.zeros(3)
-        eps = 1e-6 / speed
-        dJ = (m._jacobian(q + eps * v) - m._jacobian(q - eps * v)) / (2.0 * eps)
-        return D, h, m._forward_kinematics(q), J, dJ @ v
+        return cast(Vec, dev.max_force_n * np.maximum(np.linalg.norm(J, axis=0), 0.01))
 
     def _accel(self, q: Vec, v: Vec, tau: Vec, f_ext: Vec, ref: tuple[Vec, Vec, Vec] | None) -> Vec:
         """Joint acceleration; with tip forces also records (grip, J, J' q', f_ext) in ``_last``."""
@@ -399,3 +294,6 @@ class SimulatedArm:
         """``q'^T D q' / 2`` (J) of the arm's true state (the hand's mass not included)."""
         D, _ = self._dyn(self.q, self.v)
         return 0.5 * float(self.v @ D @ self.v)
+
+
+__all__ = ["ArmDeviceParams", "SimulatedArm"]

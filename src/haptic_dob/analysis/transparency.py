@@ -49,7 +49,7 @@ class TransparencyResult:
     @property
     def magnitude_db(self) -> np.ndarray:
         """|T| in dB per bin."""
-        return 20.0 * np.log10(np.abs(self.transparency))
+        return np.asarray(20.0 * np.log10(np.abs(self.transparency)))
 
     @property
     def mean_coherence_in_band(self) -> float:

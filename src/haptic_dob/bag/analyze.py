@@ -1,8 +1,8 @@
-"""Per-segment transparency, vibration and energy of a recorded session.
+"""Per-segment transparency, vibration and energy of a recorded session: ``analyze_bag``.
 
-``analyze_arrays`` is the whole analysis of one steady stretch from plain arrays (the same
-function the bag path and an in-process check call); ``analyze_bag`` reads a bag, labels its
-segments with the recorded parameters and analyses each.
+``analyze_bag`` reads a bag, resamples it onto one grid (``haptic_dob.bag.resample``), labels its
+segments with the recorded parameters (``haptic_dob.bag.segments``) and analyses each with
+``haptic_dob.analysis.analyze_arrays`` (the same function an in-process check calls on arrays).
 
 Per segment, the first ``settle_s`` (first segment: the hand's ramp-in) or ``transient_s`` (after
 a parameter change) are left out, at most a quarter of the segment, as
@@ -16,23 +16,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from haptic_dob.analysis.energy import EnergyResult, passivity_observer
-from haptic_dob.analysis.transparency import (
-    DEFAULT_FMAX_HZ,
-    DEFAULT_SEGMENT_S,
-    TransparencyResult,
-    transparency,
-)
+from haptic_dob.analysis.figures import analyze_arrays
+from haptic_dob.analysis.oscillation import OscillationSettings
+from haptic_dob.analysis.transparency import DEFAULT_FMAX_HZ, DEFAULT_SEGMENT_S
 from haptic_dob.analysis.vibration import PerturbationResponse, perturbation_response
 from haptic_dob.bag.errors import BagError
-from haptic_dob.bag.oscillation import Oscillation, OscillationSettings, oscillation
-from haptic_dob.bag.reader import AXES, JOINT_STATE, Selection, read_bag
-from haptic_dob.bag.record import Record, build_record
+from haptic_dob.bag.reader import AXES, Selection, read_bag
+from haptic_dob.bag.resample import Record, build_record
+from haptic_dob.bag.results import BagAnalysis, SegmentResult
 from haptic_dob.bag.segments import Segment, parameter_history, split
+from haptic_dob.bag.series import JOINT_STATE
 
 
 @dataclass(frozen=True)
@@ -58,161 +54,6 @@ class AnalysisSettings:
         k = self.stiffness_n_per_m
         if k is not None and not (k > 0.0 and math.isfinite(k)):
             raise ValueError(f"stiffness must be > 0 N/m, got {k:g}")
-
-
-@dataclass
-class Figures:
-    """The analysis of one stretch of samples."""
-
-    transparency: TransparencyResult | None
-    energy: EnergyResult
-    in_contact_pct: float | None
-    oscillation: Oscillation | None
-    problem: str | None  # why there is no transparency (too short, no motion, no stiffness)
-
-
-def analyze_arrays(
-    x: np.ndarray,
-    force: np.ndarray,
-    velocity: np.ndarray,
-    fs_hz: float,
-    stiffness_n_per_m: float | None,
-    damping_n_s_per_m: float = 0.0,
-    penetration: np.ndarray | None = None,
-    fmax_hz: float = DEFAULT_FMAX_HZ,
-    segment_s: float = DEFAULT_SEGMENT_S,
-    oscillation_settings: OscillationSettings | None = None,
-) -> Figures:
-    """Transparency, energy, contact and vibration of motion x (m), hand force (N), v (m/s).
-
-    ``penetration`` (m, > 0 in the wall) gives the contact share; the record should already
-    leave out what is to be left out.
-    """
-    dt = 1.0 / fs_hz
-    energy = passivity_observer(force, velocity, dt)
-    touching = None if penetration is None else penetration > 0.0
-    contact = None if touching is None else float(np.mean(touching) * 100.0)
-    osc = oscillation(x, fs_hz, touching, oscillation_settings, segment_s)
-    tr, problem = None, None
-    if stiffness_n_per_m is None:
-        problem = "no wall stiffness recorded (pass --stiffness)"
-    elif stiffness_n_per_m <= 0.0:
-        problem = "the wall stiffness is 0 (no wall): transparency is undefined"
-    else:
-        try:
-            tr = transparency(
-                x, force, fs_hz, stiffness_n_per_m, damping_n_s_per_m, fmax_hz, segment_s
-            )
-        except ValueError as exc:  # too short for the spectral settings, or no motion
-            problem = str(exc)
-    return Figures(tr, energy, contact, osc, problem)
-
-
-@dataclass
-class SegmentResult:
-    """One labelled segment of a bag and its figures."""
-
-    bag: str
-    segment: Segment
-    start_s: float  # stamp time of the first sample (s)
-    end_s: float  # stamp time after the last sample (s)
-    analysed_from_s: float  # start of the analysed part (s)
-    analysed_s: float  # length of the analysed part (s)
-    stiffness_n_per_m: float | None
-    stiffness_source: str  # "recorded", "--stiffness" or "unknown"
-    damping_n_s_per_m: float
-    figures: Figures
-    record: Record = field(repr=False)
-    window: slice = field(repr=False)
-    perturbation: PerturbationResponse | None = None  # push-and-hold sessions: the pulse's answer
-
-    @property
-    def controller(self) -> str:
-        """OL, CL, DOB or '?' when no controller parameters were recorded."""
-        mode = self.segment.value("controller_node", "mode")
-        return str(mode) if mode is not None else "?"
-
-    @property
-    def kf(self) -> float | None:
-        """Force-feedback gain (None if unknown)."""
-        kf = self.segment.value("controller_node", "kf")
-        return None if kf is None else float(kf)
-
-    @property
-    def label(self) -> str:
-        """``DOB Kf=1, 800 N/m`` style label."""
-        c = self.controller
-        kf = self.kf
-        ctl = c if c in ("OL", "?") or kf is None else f"{c} Kf={kf:g}"
-        k = self.stiffness_n_per_m
-        return f"{ctl}, {k:g} N/m" if k is not None else f"{ctl}, K unknown"
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready figures (SI units in the names; None where not available)."""
-        f = self.figures
-        tr, en, osc = f.transparency, f.energy, f.oscillation
-        seg = self.segment
-        return {
-            "bag": self.bag,
-            "segment": seg.index,
-            "controller": self.controller,
-            "kf": self.kf,
-            "stiffness_n_per_m": self.stiffness_n_per_m,
-            "stiffness_source": self.stiffness_source,
-            "damping_n_s_per_m": self.damping_n_s_per_m,
-            "observer_gain": _num(seg.value("observer_node", "gain")),
-            "observer_output_limit": _num(seg.value("observer_node", "output_limit")),
-            "start_s": self.start_s,
-            "end_s": self.end_s,
-            "duration_s": self.end_s - self.start_s,
-            "analysed_from_s": self.analysed_from_s,
-            "analysed_s": self.analysed_s,
-            "bandwidth_hz": None if tr is None else tr.bandwidth_hz,
-            "band_limited_by_fmax": None if tr is None else tr.band_limited_by_fmax,
-            "impedance_error_pct": None if tr is None else _num(tr.impedance_error_pct),
-            "coherence_in_band": None if tr is None else _num(tr.mean_coherence_in_band),
-            "in_contact_pct": f.in_contact_pct,
-            "vibrating": None if osc is None else osc.vibrating,
-            "vibration_amplitude_m": None if osc is None else _num(osc.amplitude_m),
-            "vibration_frequency_hz": None if osc is None else _num(osc.frequency_hz),
-            "vibration_growth_per_s": None if osc is None else _num(osc.growth_per_s),
-            "vibration_peak_fraction": None if osc is None else _num(osc.peak_fraction),
-            "vibrating_s": None if osc is None else osc.vibrating_s,
-            "max_active_energy_j": en.max_active_j,
-            "max_active_at_s": (
-                self.analysed_from_s + en.t_max_active_s if en.max_active_j > 0 else None
-            ),
-            "final_energy_j": en.final_j,
-            "perturbation_growth_per_s": None
-            if self.perturbation is None
-            else _num(self.perturbation.growth_per_s),
-            "perturbation_vibrates": None
-            if self.perturbation is None
-            else self.perturbation.vibrates,
-            "missing_samples": self.record.missing,
-            "sample_rate_hz": self.record.fs_hz,
-            "parameters": seg.params,
-            "problem": f.problem,
-        }
-
-
-def _num(v: Any) -> float | None:
-    if v is None:
-        return None
-    v = float(v)
-    return v if math.isfinite(v) else None
-
-
-@dataclass
-class BagAnalysis:
-    """Every segment of one bag."""
-
-    path: str
-    storage: str
-    motion_topic: str
-    force_topic: str
-    velocity_source: str
-    segments: list[SegmentResult]
 
 
 def skip_samples(seg_size: int, skip_s: float, fs_hz: float) -> int:

@@ -43,7 +43,7 @@ def header_stamp_ns(data: bytes | memoryview) -> int | None:
     if len(data) < 12 or data[1] != 1:
         return None
     sec, nsec = _STAMP.unpack_from(data, 4)
-    return sec * NS_PER_S + nsec
+    return int(sec * NS_PER_S + nsec)
 
 
 def command_label_stamp_ns(data: bytes | memoryview) -> int | None:

@@ -40,8 +40,8 @@ def command(
     plot_dir: str | None,
 ) -> int:
     """Analyse ``bags`` and print the chosen output; raises ``BagError``/``ValueError``."""
+    from haptic_dob.analysis.oscillation import OscillationSettings
     from haptic_dob.bag.analyze import AnalysisSettings, analyze_bag
-    from haptic_dob.bag.oscillation import OscillationSettings
     from haptic_dob.bag.reader import Selection
     from haptic_dob.bag.report import as_csv, as_json, summary, table
 

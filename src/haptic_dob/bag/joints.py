@@ -13,11 +13,10 @@ from typing import Any
 
 import numpy as np
 
+from haptic_dob.bag.bagfile import listing, open_bag, resolve_topic, topics_of
 from haptic_dob.bag.errors import BagError
-from haptic_dob.bag.reader import listing, open_bag, resolve_topic, topics_of
+from haptic_dob.bag.series import JOINT_STATE
 from haptic_dob.identification import JointRecord
-
-JOINT_STATE = "sensor_msgs/msg/JointState"
 
 
 def read_joint(

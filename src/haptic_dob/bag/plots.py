@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from haptic_dob.analysis.transparency import BAND_DB
-from haptic_dob.bag.analyze import BagAnalysis, SegmentResult
+from haptic_dob.bag.results import BagAnalysis, SegmentResult
 
 MAX_POINTS = 20_000
 

@@ -15,7 +15,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from haptic_dob.bag.analyze import BagAnalysis, SegmentResult
+from haptic_dob.bag.results import BagAnalysis, SegmentResult
 
 CSV_FIELDS = (
     "bag",

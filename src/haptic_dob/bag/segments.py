@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from haptic_dob.bag.reader import ParamEvent
+from haptic_dob.bag.param_events import ParamEvent
 
 #: node name -> the parameters that define a segment (the device's are read-only: they never
 #: split a session, they label it -- the hand's protocol, the plant's friction, the seed)

@@ -1,4 +1,4 @@
-"""One uniformly sampled record of motion, hand force and velocity on the motion topic's stamps.
+"""Resampling: a bag's motion, hand force and velocity as one ``Record`` on a uniform grid.
 
 The loop stamps sample k with ``k * T`` on every topic, so motion and force normally share their
 stamps exactly and are simply paired. Otherwise (another driver, a lost message) the force is
@@ -14,7 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from haptic_dob.bag.errors import BagError
-from haptic_dob.bag.reader import BagData, Series
+from haptic_dob.bag.reader import BagData
+from haptic_dob.bag.series import Series
 
 MIN_SHARED = 0.99  # fraction of motion stamps the force must share to pair them exactly
 

@@ -1,0 +1,129 @@
+"""Benchmarks of the node graph as ``haptic-launch slide_sim`` starts it: lockstep and real time.
+
+Each run is a fresh ``haptic-launch`` on a random ``ROS_DOMAIN_ID`` (localhost only), 20 s at
+1 kHz, laid out by default (the loop's four nodes in one process), ``--composed`` or
+``--processes``; ``GRAPH_ARGS`` adds the command line's ``--set``, ``--rt-priority``, ``--pin``
+and ``--cpu-latency``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+
+#: extra ``haptic-launch`` arguments of the graph benchmarks (--set, --rt-priority, --pin,
+#: --cpu-latency); ``benchmarks.py`` fills it from its command line
+GRAPH_ARGS: list[str] = []
+
+
+def graph_args(extra: list[str]) -> list[str]:
+    """A benchmark's arguments and ``GRAPH_ARGS``; ``--pin`` only where every node has a process
+    of its own (``--processes``): haptic-launch refuses it for nodes sharing a process."""
+    args = [*extra, *GRAPH_ARGS]
+    return args if "--processes" in args else [a for a in args if a != "--pin"]
+
+
+def _launch(extra: list[str], sets: list[str], timeout: float) -> str:
+    """Run ``haptic-launch slide_sim`` on a fresh domain; return its combined output."""
+    env = dict(
+        os.environ,
+        ROS_DOMAIN_ID=str(random.randint(1, 100)),
+        ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+    )
+    argv = [os.path.join(os.path.dirname(sys.executable), "haptic-launch"), "slide_sim", *extra]
+    for item in sets:
+        argv += ["--set", item]
+    out = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=timeout)
+    if out.returncode != 0:
+        raise RuntimeError(f"haptic-launch failed ({out.returncode}): {out.stderr[-2000:]}")
+    return out.stdout + out.stderr
+
+
+def real_time_factor(extra: list[str], seconds: float = 20.0) -> float:
+    """One lockstep graph run's real-time factor, as the device node reports it."""
+    text = _launch(graph_args(extra), [f"device_node:duration_s={seconds}"], 300)
+    found = re.search(r"real-time factor ([0-9.]+)", text)
+    if found is None:
+        raise RuntimeError(f"no real-time factor in the launch output: {text[-1500:]}")
+    return float(found.group(1))
+
+
+def lockstep_cycle_us(extra: list[str], seconds: float = 20.0) -> float:
+    """One lockstep graph run's time per cycle (µs), from the device's real-time factor."""
+    return 1e3 / real_time_factor(extra, seconds)
+
+
+def _lockstep(repeat: int, extra: list[str]) -> str:
+    rtf = [real_time_factor(extra) for _ in range(repeat)]
+    per_cycle_us = 1e3 / statistics.median(rtf)
+    return (
+        f"real-time factor median {statistics.median(rtf):.2f} (runs: "
+        f"{', '.join(f'{r:.2f}' for r in sorted(rtf))}) -> {per_cycle_us:.0f} us per cycle"
+    )
+
+
+def bench_lockstep(repeat: int) -> str:
+    """The lockstep graph at 1 kHz, 20 s simulated, as haptic-launch lays it out by default
+    (the loop's four nodes in one process): real-time factor."""
+    return _lockstep(repeat, [])
+
+
+def bench_lockstep_composed(repeat: int) -> str:
+    """The same graph, every node in one process (``--composed``)."""
+    return _lockstep(repeat, ["--composed"])
+
+
+def bench_lockstep_processes(repeat: int) -> str:
+    """The same graph, every node in a process of its own (``--processes``)."""
+    return _lockstep(repeat, ["--processes"])
+
+
+def _realtime(repeat: int, extra: list[str]) -> str:
+    rows = []
+    for _ in range(repeat):
+        with tempfile.TemporaryDirectory() as tmp:
+            stats = os.path.join(tmp, "stats.json")
+            _launch(
+                graph_args(extra),
+                [
+                    "device_node:clock_mode=realtime",
+                    "device_node:duration_s=20.0",
+                    f"device_node:stats_file={stats}",
+                ],
+                300,
+            )
+            with open(stats, encoding="utf-8") as fh:
+                rows.append(json.load(fh))
+    med = {
+        k: statistics.median(r[k] for r in rows)
+        for k in ("on_time_pct", "latency_p50_ms", "latency_p99_ms", "missed_ticks")
+    }
+    runs = ", ".join(f"{r['on_time_pct']:.2f}" for r in rows)
+    return (
+        f"commands before the next tick: median {med['on_time_pct']:.2f} % (runs: "
+        f"{runs}); sample-to-command latency "
+        f"p50 {med['latency_p50_ms']:.3f} ms, p99 {med['latency_p99_ms']:.3f} ms; "
+        f"missed ticks {med['missed_ticks']:g} of 20000"
+    )
+
+
+def bench_realtime(repeat: int) -> str:
+    """The graph in real time at 1 kHz for 20 s, laid out by default (the loop in one
+    process): on-time share and latency."""
+    return _realtime(repeat, [])
+
+
+def bench_realtime_composed(repeat: int) -> str:
+    """The same, every node in one process (``--composed``)."""
+    return _realtime(repeat, ["--composed"])
+
+
+def bench_realtime_processes(repeat: int) -> str:
+    """The same, every node in a process of its own (``--processes``)."""
+    return _realtime(repeat, ["--processes"])

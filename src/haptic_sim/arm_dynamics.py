@@ -1,0 +1,71 @@
+"""The rigid-body dynamics the simulated arm (``haptic_sim.arm``) integrates, from any model.
+
+- ``mass_and_bias``: ``D(q)`` and the bias effort ``h(q, q')`` (Coriolis, gravity, friction)
+  from the model's one-pass ``_mass_and_bias`` (pinocchio models) or its two separate methods;
+- ``dynamics_and_tip``: those plus the end-effector point ``p``, its Jacobian ``J`` and
+  ``J' q'``, from the model's one-pass ``_dynamics_and_tip`` where it has one, else ``J' q'`` by
+  central differences of ``J`` along ``q'``;
+- ``solve``: the linear solve of the accelerations, a 3x3 system by cofactors.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import cast
+
+import numpy as np
+
+from haptic_dob.models.base import DeviceModel, Mat, Vec
+
+#: (q, q') -> (D, h)
+MassAndBias = Callable[[Vec, Vec], tuple[Mat, Vec]]
+#: (q, q') -> (D, h, p, J, J' q')
+DynamicsAndTip = Callable[[Vec, Vec], tuple[Mat, Vec, Vec, Mat, Vec]]
+
+
+def mass_and_bias(model: DeviceModel) -> MassAndBias:
+    """``(q, q') -> (D, h)`` of ``model``: its one-pass method when it has one."""
+    one_pass: MassAndBias | None = getattr(model, "_mass_and_bias", None)
+    return one_pass or (lambda q, qd: (model._mass_matrix(q), model._bias_effort(q, qd)))
+
+
+def dynamics_and_tip(model: DeviceModel) -> DynamicsAndTip:
+    """``(q, q') -> (D, h, p, J, J' q')`` of ``model``: its one-pass method when it has one."""
+    one_pass: DynamicsAndTip | None = getattr(model, "_dynamics_and_tip", None)
+    if one_pass is not None:
+        return one_pass
+    dyn = mass_and_bias(model)
+
+    def generic(q: Vec, v: Vec) -> tuple[Mat, Vec, Vec, Mat, Vec]:
+        """D, h, p, J and J' q' for a model without a one-pass method (J' q' by differences)."""
+        D, h = dyn(q, v)
+        J = model._jacobian(q)
+        speed = float(np.linalg.norm(v))
+        if speed == 0.0:
+            return D, h, model._forward_kinematics(q), J, np.zeros(3)
+        eps = 1e-6 / speed
+        dJ = (model._jacobian(q + eps * v) - model._jacobian(q - eps * v)) / (2.0 * eps)
+        return D, h, model._forward_kinematics(q), J, dJ @ v
+
+    return generic
+
+
+def solve(A: Mat, b: Vec) -> Vec:
+    """``A x = b``; a 3x3 system by cofactors in floats (several times faster than LAPACK here)."""
+    if A.shape != (3, 3):
+        return cast(Vec, np.linalg.solve(A, b))
+    (a, b_, c), (d, e, f), (g, h, i) = A.tolist()
+    c00, c01, c02 = e * i - f * h, f * g - d * i, d * h - e * g
+    det = a * c00 + b_ * c01 + c * c02
+    if det == 0.0 or not math.isfinite(det):
+        return cast(Vec, np.linalg.solve(A, b))
+    r = 1.0 / det
+    x0, x1, x2 = b.tolist()
+    return np.array(
+        (
+            (c00 * x0 + (c * h - b_ * i) * x1 + (b_ * f - c * e) * x2) * r,
+            (c01 * x0 + (a * i - c * g) * x1 + (c * d - a * f) * x2) * r,
+            (c02 * x0 + (b_ * g - a * h) * x1 + (a * e - b_ * d) * x2) * r,
+        )
+    )
