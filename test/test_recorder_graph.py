@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import os
 import signal
-import time
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +19,7 @@ from haptic_msgs_py.topics import RECORDER_PROGRESS
 from haptic_sim.session import SessionConfig, run_session
 from recorded import assert_received_written_in_bag, bag_stamps
 from rosgraph import Collector, Process, isolated_env, launch, resent, switch
+from waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -170,12 +170,9 @@ def test_signals_leave_readable_bags_and_a_live_switch_splits_the_session(root, 
         return max((m.stamp.sec + m.stamp.nanosec * 1e-9 for m in msgs), default=0.0)
 
     def reach(seconds: float, timeout: float) -> None:
-        end = time.monotonic() + timeout
-        while progress() < seconds:
-            assert time.monotonic() < end, f"the session did not reach {seconds} s\n" + (
-                graph.output()
-            )
-            time.sleep(0.05)
+        assert wait_until(lambda: progress() >= seconds, timeout), (
+            f"the session did not reach {seconds} s\n" + graph.output()
+        )
 
     try:
         reach(6.0, 120)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -14,49 +15,15 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
 from conftest import tool
-from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
 from haptic_dob.bag.reader import open_bag
-from haptic_dob.nodes.recorder_node import (
-    DEFAULT_TOPICS,
-    RecorderNode,
-    parse_topics,
-    stamp_reader,
-)
+from haptic_dob.nodes.recorder_node import RecorderNode
 from haptic_msgs_py import wire
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.raw import RawPublisher
 from haptic_msgs_py.stamps import command_label
-from haptic_msgs_py.topics import EE_POSE, EFFORT_COMMAND, PARAMETER_EVENTS, SESSION_TOPICS
+from haptic_msgs_py.topics import EE_POSE, EFFORT_COMMAND, SESSION_TOPICS
 from rosgraph import isolated_env
-
-
-def test_topics_default_and_parsing() -> None:
-    assert [*SESSION_TOPICS, PARAMETER_EVENTS] == DEFAULT_TOPICS
-    assert parse_topics(["ee_pose", "/parameter_events", "/other:std_msgs/msg/String"]) == [
-        ("ee_pose", "geometry_msgs/msg/PoseStamped"),
-        ("/parameter_events", "rcl_interfaces/msg/ParameterEvent"),
-        ("/other", "std_msgs/msg/String"),
-    ]
-    with pytest.raises(ValueError, match="'odometry' is not a session topic; give its type"):
-        parse_topics(["odometry"])
-    with pytest.raises(ValueError, match="unknown message type 'foo/msg/Bar' for x"):
-        parse_topics(["x:foo/msg/Bar"])
-    with pytest.raises(ValueError, match="ee_pose is listed twice"):
-        parse_topics(["ee_pose", "ee_pose"])
-
-
-def test_stamps_are_read_from_the_bytes() -> None:
-    pose = wire.pose_stamped("base_link")
-    pose.header.stamp.sec, pose.header.stamp.nanosec = 12, 345_000_000
-    assert header_stamp_ns(wire.encode(pose)) == 12_345_000_000
-    cmd = wire.float64_multi_array(command_label(7_000_000), [0.5])
-    assert command_label_stamp_ns(wire.encode(cmd)) == 7_000_000
-    assert command_label_stamp_ns(wire.encode(wire.float64_multi_array("x", [0.5]))) is None
-    assert stamp_reader("/ee_pose", SESSION_TOPICS[EE_POSE]) is header_stamp_ns
-    assert stamp_reader("/ns/effort_command", SESSION_TOPICS[EFFORT_COMMAND]) is (
-        command_label_stamp_ns
-    )
-    assert stamp_reader("/parameter_events", "rcl_interfaces/msg/ParameterEvent") is None
+from waits import wait_until
 
 
 @pytest.fixture
@@ -69,13 +36,9 @@ def context(monkeypatch: pytest.MonkeyPatch):
     rclpy.try_shutdown(context=ctx)
 
 
-def spin_until(ex: SingleThreadedExecutor, done, timeout: float) -> bool:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if done():
-            return True
-        ex.spin_once(timeout_sec=0.01)
-    return done()
+def spin(ex: SingleThreadedExecutor) -> Callable[[], None]:
+    """One executor turn: the ``step`` of ``wait_until``."""
+    return lambda: ex.spin_once(timeout_sec=0.01)
 
 
 @pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
@@ -97,8 +60,9 @@ def test_records_counts_snapshots_and_reports_progress(context, tmp_path, storag
     ex = SingleThreadedExecutor(context=context)
     ex.add_node(rec)
     ex.add_node(src)
+    counts = rec.recording.counts
     try:
-        assert spin_until(ex, lambda: rec.snapshots == 1, 10.0), "no parameter snapshot"
+        assert wait_until(lambda: counts.snapshots == 1, 10.0, step=spin(ex)), "no snapshot"
         assert rec.progress_ns() == 0  # publishers matched, nothing written yet
         pose = wire.pose_stamped("base_link")
         stamps = [k * 1_000_000 for k in range(200) if k != 50]  # sample 50 never sent
@@ -106,24 +70,24 @@ def test_records_counts_snapshots_and_reports_progress(context, tmp_path, storag
             pose.header.stamp.sec, pose.header.stamp.nanosec = divmod(s, 1_000_000_000)
             pose_pub.publish(pose)
             cmd_pub.publish(wire.float64_multi_array(command_label(s), [0.1]))
-        assert spin_until(ex, lambda: rec.counts[1].received == len(stamps), 10.0)
+        assert wait_until(lambda: counts.topics[1].received == len(stamps), 10.0, step=spin(ex))
         assert rec.progress_ns() == stamps[-1]
-        live = rec.counts[2].received  # the node's own declarations, if they came in time
+        live = counts.topics[2].received  # the node's own declarations, if they came in time
         src.set_parameters([Parameter("stiffness_n_per_m", value=1600.0)])
-        assert spin_until(ex, lambda: rec.counts[2].received == live + 1, 10.0)
+        assert wait_until(lambda: counts.topics[2].received == live + 1, 10.0, step=spin(ex))
     finally:
         ex.shutdown()
         rec.close()
         src.destroy_node()
         rec.destroy_node()
-    pose_c, cmd_c, ev_c = rec.counts
+    pose_c, cmd_c, ev_c = counts.topics
     assert (pose_c.received, pose_c.written, pose_c.gaps) == (199, 199, 1)
     assert (cmd_c.received, cmd_c.written, cmd_c.gaps) == (199, 199, 1)
     assert (pose_c.first_ns, pose_c.newest_ns) == (0, 199_000_000)
     assert ev_c.written == ev_c.received + 1  # the live events and the snapshot
     with open_bag(out) as reader:
-        counts = {c.topic: c.msgcount for c in reader.connections}
-        assert counts == {
+        in_bag = {c.topic: c.msgcount for c in reader.connections}
+        assert in_bag == {
             "/ee_pose": 199,
             "/effort_command": 199,
             "/parameter_events": ev_c.written,
@@ -147,7 +111,7 @@ def test_records_counts_snapshots_and_reports_progress(context, tmp_path, storag
     ]
     meta = (out / "metadata.yaml").read_text()
     assert "haptic_dob.recorder" in meta
-    report = rec.report()
+    report = counts.to_json()
     assert report["topics"]["/ee_pose"]["written"] == 199
     assert json.loads(json.dumps(report)) == report
 
@@ -169,20 +133,25 @@ def test_progress_is_held_while_a_node_has_not_given_its_parameters(context, tmp
     ex.add_node(rec)
     ex.add_node(src)
     try:
-        assert spin_until(ex, lambda: any(p.node == "/silent_node" for p in rec._pending), 10.0)
+        assert wait_until(
+            lambda: any(p.node == "/silent_node" for p in rec.snapshots.pending),
+            10.0,
+            step=spin(ex),
+        )
         t_seen = time.monotonic()
         pose = wire.pose_stamped("base_link")
         for k in range(100):
             pose.header.stamp.sec, pose.header.stamp.nanosec = divmod(k * 1_000_000, 10**9)
             pose_pub.publish(pose)
-        assert spin_until(ex, lambda: rec.counts[0].received == 100, 10.0)
+        pose_c = rec.recording.counts.topics[0]
+        assert wait_until(lambda: pose_c.received == 100, 10.0, step=spin(ex))
         assert rec.progress_ns() == 99_000_000
         if time.monotonic() - t_seen < 0.9:  # still within snapshot_timeout_s
             assert rec.reported_progress_ns() == 0
         # the node never answers: after the timeout it is warned about and the hold ends
-        assert spin_until(ex, lambda: rec.reported_progress_ns() == 99_000_000, 10.0)
+        assert wait_until(lambda: rec.reported_progress_ns() == 99_000_000, 10.0, step=spin(ex))
         assert time.monotonic() - t_seen >= 0.9
-        assert rec.snapshots == 0
+        assert rec.recording.counts.snapshots == 0
     finally:
         ex.shutdown()
         rec.close()

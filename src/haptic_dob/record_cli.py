@@ -11,12 +11,9 @@ from __future__ import annotations
 
 import math
 import sys
-import time
-from pathlib import Path
 
 from haptic_dob.cli import ArgumentParser, CliError, run
-
-STORAGES = ("mcap", "sqlite3")
+from haptic_dob.recorder.settings import STORAGES, new_bag_path
 
 
 def command(
@@ -28,21 +25,20 @@ def command(
     node_name: str,
     rate_hz: float,
 ) -> int:
-    """Check the arguments, record, print the counts; raises ``CliError`` on bad input."""
-    out = output or time.strftime("haptic_%Y%m%d_%H%M%S")
-    if Path(out).exists():
-        raise CliError(f"{out} exists already; the recorder never overwrites a bag")
+    """Check the arguments, record, print the counts; ``CliError``/``ValueError`` on bad input."""
+    path = new_bag_path(output or "")
     if not (duration >= 0.0 and math.isfinite(duration)):
         raise CliError(f"--duration must be >= 0 s, got {duration:g}")
     if not (rate_hz > 0.0 and math.isfinite(rate_hz)):
         raise CliError(f"--rate must be > 0 Hz, got {rate_hz:g}")
     if namespace and not namespace.startswith("/"):
         namespace = "/" + namespace
-    from haptic_dob.nodes.recorder_node import record, summary_table
+    from haptic_dob.nodes.recorder_run import record
 
-    code, node = record(out, storage, namespace, duration, topics, node_name, rate_hz)
+    code, node = record(str(path), storage, namespace, duration, topics, node_name, rate_hz)
     if node is not None:
-        print(summary_table(node))
+        rec = node.recording
+        print(rec.counts.table(rec.path, rec.storage))
     return code
 
 

@@ -5,7 +5,8 @@ The bag looks like a recording of the node graph: ``ee_pose``, ``ee_twist`` and
 receive (bag) times ``epoch + k * T``, and ``/parameter_events`` with one snapshot per node
 before the first sample plus a change event just before the sample where it takes effect.
 Messages are encoded once as templates and then patched in place (stamp and numbers), so an
-hour at 1 kHz is written at the speed of the storage writer.
+hour at 1 kHz is written at the speed of the storage writer. ``open_writer`` opens a new bag for
+any writer (the recorder's too).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import struct
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,6 +34,9 @@ from haptic_msgs_py.topics import (
     WRENCH_ESTIMATE,
     WRENCH_MEASURED,
 )
+
+if TYPE_CHECKING:
+    from rosbags.rosbag2 import Writer
 
 EPOCH_NS = 1_767_225_600 * NS_PER_S  # 2026-01-01: receive times of written bags start here
 _MARK = 1.0e-300  # marker values located in a template's bytes
@@ -204,6 +208,19 @@ def parameter_event(
     return wire.encode(ev)
 
 
+def open_writer(path: str | Path, storage: str) -> Writer:
+    """An open ``rosbags`` writer of a new bag (rosbag2 format 9) in ``storage`` (mcap, sqlite3).
+
+    Raises ``rosbags.rosbag2.WriterError`` or ``OSError`` when the bag cannot be created.
+    """
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    plugin = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}[storage]
+    writer = Writer(Path(path), version=9, storage_plugin=plugin)
+    writer.open()
+    return writer
+
+
 @dataclass(frozen=True)
 class ParamChange:
     """Parameters of one node that change just before sample ``index``."""
@@ -236,17 +253,13 @@ def write_session_bag(
             wrench_estimate, effort_estimate and effort_command (what a recording holds).
         namespace: '' or '/ns' for topic and node names.
     """
-    from rosbags.rosbag2 import StoragePlugin, Writer
-
     n = int(np.asarray(x).size)
     xs = np.asarray(x, np.float64).tolist()
     fs_ = np.asarray(force, np.float64).tolist()
     vs = None if velocity is None else np.asarray(velocity, np.float64).tolist()
     period = round(NS_PER_S / rate_hz)
-    plugin = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}[storage]
     ns = namespace.rstrip("/")
-    writer = Writer(Path(path), version=9, storage_plugin=plugin)
-    writer.open()
+    writer = open_writer(path, storage)
     count = 0
     try:
 

@@ -1,0 +1,84 @@
+"""The recorder's parameters, and the name of the bag it creates (never over an existing one).
+
+Light to import (no bag or ROS modules): ``haptic-record`` checks its arguments with it first.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from haptic_dob.runtime.params import ParamSpec
+from haptic_msgs_py.topics import PARAMETER_EVENTS, SESSION_TOPICS
+
+STORAGES = ("mcap", "sqlite3")  # bag storages (``haptic_dob.bag.write.open_writer``)
+DEFAULT_TOPICS = [*SESSION_TOPICS, PARAMETER_EVENTS]  # every session topic and the events
+
+
+def recorder_specs() -> list[ParamSpec]:
+    """Every parameter of the recorder node (all fixed at start)."""
+    return [
+        ParamSpec(
+            "output",
+            "",
+            "bag directory to create ('' = haptic_<date>_<time> in the working directory)",
+            read_only=True,
+        ),
+        ParamSpec("storage", "mcap", "bag storage", choices=STORAGES, read_only=True),
+        ParamSpec(
+            "topics",
+            list(DEFAULT_TOPICS),
+            "topics to record: session topics and /parameter_events by name, others as "
+            "NAME:pkg/msg/Type",
+            read_only=True,
+        ),
+        ParamSpec(
+            "duration_s",
+            0.0,
+            "stop after this long (wall clock); 0 = until stopped",
+            "s",
+            0.0,
+            1e7,
+            read_only=True,
+        ),
+        ParamSpec(
+            "rate_hz", 1000.0, "sample rate of the loop (to count missing stamps)", "Hz", 1.0, 1e5
+        ),
+        ParamSpec(
+            "progress_rate_hz",
+            50.0,
+            "rate of recorder/progress (lockstep back-pressure)",
+            "Hz",
+            20.0,
+            1000.0,
+            read_only=True,
+        ),
+        ParamSpec(
+            "snapshot_timeout_s",
+            2.0,
+            "warn when a node has not answered the parameter snapshot after this long (it is "
+            "still asked)",
+            "s",
+            0.1,
+            60.0,
+            read_only=True,
+        ),
+        ParamSpec(
+            "drain_timeout_s",
+            2.0,
+            "at shutdown: take queued messages for at most this long",
+            "s",
+            0.0,
+            60.0,
+            read_only=True,
+        ),
+    ]
+
+
+def new_bag_path(output: str) -> Path:
+    """The bag directory to create: ``output``, or ``haptic_<date>_<time>`` when it is empty;
+    ``ValueError`` when it exists (the recorder never overwrites a bag)."""
+    path = Path(output or time.strftime("haptic_%Y%m%d_%H%M%S"))
+    if path.exists():
+        raise ValueError(f"{path} exists already; the recorder never overwrites a bag")
+    return path

@@ -1,0 +1,74 @@
+"""The bag being recorded: raw bytes as they came, counts, snapshots, metadata, close."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+from rosbags.rosbag2 import Reader
+
+from haptic_dob.recorder.recording import METADATA_KEY, Recording
+from haptic_dob.recorder.settings import STORAGES
+from haptic_dob.recorder.topics import PARAMETER_EVENT_TYPE
+from haptic_msgs_py import wire
+from haptic_msgs_py.stamps import command_label
+from haptic_msgs_py.topics import EE_POSE, EFFORT_COMMAND, SESSION_TOPICS
+
+MS = 1_000_000
+
+
+def pose_bytes(stamp_ns: int) -> bytes:
+    pose = wire.pose_stamped("base_link")
+    pose.header.stamp.sec, pose.header.stamp.nanosec = divmod(stamp_ns, 1_000_000_000)
+    return wire.encode(pose)
+
+
+@pytest.mark.parametrize("storage", STORAGES)
+def test_messages_are_written_as_they_came_and_counted(tmp_path: Path, storage: str) -> None:
+    rec = Recording(tmp_path / "bag", storage, MS)
+    on_pose = rec.add_topic("/ee_pose", SESSION_TOPICS[EE_POSE])
+    on_cmd = rec.add_topic("/effort_command", SESSION_TOPICS[EFFORT_COMMAND])
+    assert not rec.records_parameter_events
+    on_events = rec.add_topic("/parameter_events", PARAMETER_EVENT_TYPE)
+    assert rec.records_parameter_events
+    sent = [pose_bytes(k * MS) for k in (0, 1, 3)]
+    for data in sent:
+        on_pose(data)
+    on_cmd(wire.encode(wire.float64_multi_array(command_label(2 * MS), [0.5])))
+    rec.write_snapshot("/node", {"gain": 2.0, "ids": [1, 2]}, {"gain": 3, "ids": 7})
+    rec.close()
+    rec.close()  # idempotent
+    on_pose(pose_bytes(4 * MS))  # after the close: received, not written
+    on_events(b"")
+    rec.write_snapshot("/late", {"x": 1.0}, {})  # nothing after the close
+    pose_c, cmd_c, ev_c = rec.counts.topics
+    assert (pose_c.received, pose_c.written, pose_c.gaps, pose_c.newest_ns) == (4, 3, 1, 3 * MS)
+    assert (cmd_c.written, cmd_c.newest_ns) == (1, 2 * MS)
+    assert (ev_c.received, ev_c.written, rec.counts.snapshots) == (1, 1, 1)
+    with Reader(tmp_path / "bag") as reader:
+        by_topic: dict[str, list[bytes]] = {}
+        for conn, _, data in reader.messages():
+            by_topic.setdefault(conn.topic, []).append(bytes(data))
+        (event,) = [
+            wire.TYPESTORE.deserialize_cdr(d, PARAMETER_EVENT_TYPE)
+            for d in by_topic["/parameter_events"]
+        ]
+    assert by_topic["/ee_pose"] == sent  # the bytes as they came
+    assert event.node == "/node" and not event.changed_parameters
+    values = {p.name: p.value for p in event.new_parameters}
+    assert (values["gain"].type, values["gain"].double_value) == (3, 2.0)
+    assert (values["ids"].type, list(values["ids"].integer_array_value)) == (7, [1, 2])
+    meta = yaml.safe_load((tmp_path / "bag" / "metadata.yaml").read_text())
+    custom = meta["rosbag2_bagfile_information"]["custom_data"][METADATA_KEY]
+    assert json.loads(custom)["topics"]["/ee_pose"]["written"] == 3
+
+
+def test_a_bag_that_cannot_be_created_is_named(tmp_path: Path) -> None:
+    (tmp_path / "bag").mkdir()
+    with pytest.raises(ValueError, match=r"^cannot create the bag .*bag: .*exists already"):
+        Recording(tmp_path / "bag", "mcap", MS)
+    (tmp_path / "file").write_text("")
+    with pytest.raises(ValueError, match=r"^cannot create the bag .*: Not a directory"):
+        Recording(tmp_path / "file" / "bag", "sqlite3", MS)
