@@ -6,7 +6,6 @@ sample, then the deferred work the spin loop would run), so the test sees each c
 
 from __future__ import annotations
 
-import time
 from collections import Counter
 
 import numpy as np
@@ -23,6 +22,7 @@ from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
 from haptic_sim.nodes.device_node import DeviceNode
 from haptic_sim.session import SessionConfig, run_session
 from rosgraph import isolated_env
+from waits import wait_until
 
 LOOP_TOPICS = {
     "/joint_states",
@@ -56,9 +56,9 @@ def composed(monkeypatch: pytest.MonkeyPatch):
     ex = EventsExecutor(context=ctx)
     for n in nodes:
         ex.add_node(n)
-    end = time.monotonic() + 0.3  # as the spin loop does before sample 0: the graph's events
-    while time.monotonic() < end:  # (matches made and undone while the nodes were built)
-        ex.spin_once(timeout_sec=0.01)
+    # as the spin loop does before sample 0: the graph's events (matches made and undone while
+    # the nodes were built) for 0.3 s
+    wait_until(lambda: False, 0.3, step=lambda: ex.spin_once(timeout_sec=0.01))
     yield ex, nodes, sends
     ex.shutdown()
     for n in nodes:
@@ -71,10 +71,10 @@ def turn(device: DeviceNode, cycles: int) -> list[float]:
     position of every sample sent."""
     bus = device._bus
     q = []
-    if not device._started:
-        device._started = True
+    if not device.loop.started:
+        device.loop.started = True
         q.append(device.device.sample().q[0])
-        device._publish(device.device.sample())
+        device.loop.publish(device.device.sample())
     for _ in range(cycles):
         assert len(bus.soon) == 1, "each command defers exactly the next sample"
         q.append(device.device.sample().q[0])  # sample k+1, moved by command k, goes out now
@@ -121,16 +121,15 @@ def test_the_nodes_and_their_topics_stay_visible_and_readers_elsewhere_get_the_s
     ex_other.add_node(reader)
     env = nodes[0]
     try:
-        end = time.monotonic() + 20
-        while (env._pub.readers < 1 or sub.get_publisher_count() < 1) and time.monotonic() < end:
-            ex.spin_once(timeout_sec=0.02)
-            ex_other.spin_once(timeout_sec=0.0)
+        wait_until(
+            lambda: env._pub.readers >= 1 and sub.get_publisher_count() >= 1,
+            20,
+            step=lambda: (ex.spin_once(timeout_sec=0.02), ex_other.spin_once(timeout_sec=0.0)),
+        )
         assert env._pub.readers == 1
         turn(device, 100)
         assert sends == Counter({"/wrench_desired": 101})  # samples 0..100; nothing else
-        end = time.monotonic() + 10
-        while len(got) < 101 and time.monotonic() < end:
-            ex_other.spin_once(timeout_sec=0.05)
+        wait_until(lambda: len(got) >= 101, 10, step=lambda: ex_other.spin_once(timeout_sec=0.05))
         assert len(got) == 101
     finally:
         ex_other.shutdown()
@@ -172,9 +171,7 @@ def test_parameter_events_carry_the_sample_a_change_applies_from(composed) -> No
     assert not env.set_parameters([Parameter("stiffness_n_per_m", value=-1.0)])[0].successful
     # the node's own clock is untouched: a refused change and the next reading see real time
     assert env.get_clock().now().nanoseconds >= before
-    end = time.monotonic() + 10
-    while len(events) < 4 and time.monotonic() < end:
-        ex.spin_once(timeout_sec=0.05)
+    wait_until(lambda: len(events) >= 4, 10, step=lambda: ex.spin_once(timeout_sec=0.05))
     ex.remove_node(listener)
     listener.destroy_node()
     from rclpy.parameter import parameter_value_to_python

@@ -154,21 +154,22 @@ def test_device_holds_the_loop_while_a_recorder_lags(context) -> None:
 
     dev = DeviceNode(context=context)
     try:
-        dev._started = True
+        dev.loop.started = True
         period = dev.period_ns
         for k in range(600):  # 0.6 s of simulated time, no recorder yet: the loop runs freely
-            dev._on_command(EffortCommand(k * period, (0.0,)))
+            dev.loop.command(EffortCommand(k * period, (0.0,)))
         assert dev.device.k == 600
         fast, slow = wire.header("/fast_recorder"), wire.header("/slow_recorder")
         fast.stamp = wire.Time(sec=0, nanosec=590_000_000)
         slow.stamp = wire.Time(sec=0, nanosec=50_000_000)  # has written 0.05 s
         dev._on_progress(fast)
         dev._on_progress(slow)
-        dev._on_command(EffortCommand(600 * period, (0.0,)))
-        assert dev.device.k == 600 and dev._held is not None  # the slowest is 0.55 s behind: held
+        dev.loop.command(EffortCommand(600 * period, (0.0,)))
+        held = dev.loop.recorders.held
+        assert dev.device.k == 600 and held is not None  # the slowest is 0.55 s behind: held
         slow.stamp = wire.Time(sec=0, nanosec=400_000_000)
         dev._on_progress(slow)  # caught up to 0.2 s behind: released
-        assert dev.device.k == 601 and dev._held is None
+        assert dev.device.k == 601 and dev.loop.recorders.held is None
         res = dev.set_parameters([Parameter("max_recorder_lag_s", value=0.0)])[0]
         assert not res.successful
     finally:
@@ -222,10 +223,10 @@ def test_a_realtime_device_ticks_only_once_its_graph_is_up(monkeypatch, wait_for
         for _ in range(5):
             dev.on_wakeup(time.monotonic())
         if wait_for == "[]":
-            assert dev._started and dev.device.k >= 1
+            assert dev.loop.started and dev.device.k >= 1
         else:
-            assert not dev._started and dev.device.k == 0
-            assert dev._waiting_for() == "node absent_node in /"
+            assert not dev.loop.started and dev.device.k == 0
+            assert dev.waiting_for() == "node absent_node in /"
             assert dev._report()[1] == "waiting for the graph"
     finally:
         dev.destroy_node()

@@ -62,12 +62,12 @@ def test_no_bad_command_reaches_the_plant(context, stream) -> None:
         dev.set_parameters([Parameter("effort_limits", value=[3.0])])
         assert dev.limits == (3.0,)
         now = 100.0
-        dev._tick(now)  # start: sample 0
+        dev.loop.tick(now)  # start: sample 0
         for cmd in stream:
             k = dev.device.k
-            dev._on_command(EffortCommand(k * dev.period_ns, tuple(cmd)))
+            dev.loop.command(EffortCommand(k * dev.period_ns, tuple(cmd)))
             now += 0.001
-            dev._tick(now)
+            dev.loop.tick(now)
             applied = dev.device.sample().effort[0]
             assert math.isfinite(applied) and abs(applied) <= 3.0
             valid = len(cmd) == 1 and math.isfinite(cmd[0])
@@ -84,20 +84,20 @@ def test_watchdog_zeroes_the_effort_and_the_next_command_resumes(context) -> Non
     try:
         limit = round(dev.params.values["command_timeout_s"] * 1e9 / dev.period_ns)  # samples
         t = 10.0
-        dev._tick(t)
-        dev._on_command(EffortCommand(0, (1.5,)))
+        dev.loop.tick(t)
+        dev.loop.command(EffortCommand(0, (1.5,)))
         for _ in range(limit + 1):  # held over [1, limit + 1): the timeout after the command
             t += 0.001
-            dev._tick(t)
-            assert dev.device.sample().effort == (1.5,) and not dev.watchdog_tripped
+            dev.loop.tick(t)
+            assert dev.device.sample().effort == (1.5,) and not dev.loop.watchdog.tripped
         t += 0.001
-        dev._tick(t)
-        assert dev.device.sample().effort == (0.0,) and dev.watchdog_tripped
+        dev.loop.tick(t)
+        assert dev.device.sample().effort == (0.0,) and dev.loop.watchdog.tripped
         _level, message, values = dev._report()
         assert "watchdog tripped" in message and values["watchdog"].startswith("tripped")
-        dev._on_command(EffortCommand(dev.device.k * dev.period_ns, (-1.0,)))
-        dev._tick(t + 0.001)
-        assert dev.device.sample().effort == (-1.0,) and not dev.watchdog_tripped
+        dev.loop.command(EffortCommand(dev.device.k * dev.period_ns, (-1.0,)))
+        dev.loop.tick(t + 0.001)
+        assert dev.device.sample().effort == (-1.0,) and not dev.loop.watchdog.tripped
     finally:
         dev.destroy_node()
 
@@ -110,14 +110,14 @@ def test_watchdog_counts_the_plant_s_samples_not_the_wall_clock(context, gap_s: 
     dev = DeviceNode(context=context)
     try:
         limit = round(dev.params.values["command_timeout_s"] * 1e9 / dev.period_ns)  # samples
-        dev._tick(10.0)
-        dev._on_command(EffortCommand(0, (1.5,)))
+        dev.loop.tick(10.0)
+        dev.loop.command(EffortCommand(0, (1.5,)))
         t = 10.0 + gap_s
         for _ in range(limit + 1):
-            dev._tick(t)
-            assert dev.device.sample().effort == (1.5,) and not dev.watchdog_tripped
-        dev._tick(t)
-        assert dev.device.sample().effort == (0.0,) and dev.watchdog_tripped
+            dev.loop.tick(t)
+            assert dev.device.sample().effort == (1.5,) and not dev.loop.watchdog.tripped
+        dev.loop.tick(t)
+        assert dev.device.sample().effort == (0.0,) and dev.loop.watchdog.tripped
     finally:
         dev.destroy_node()
 

@@ -15,6 +15,7 @@ floats (N) so the 1 kHz loop runs without array allocation.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -110,18 +111,26 @@ def joint_effort(jacobian: np.ndarray, force: Force) -> list[float]:
     dof = jacobian.shape[1]
     if dof == 1:
         return [jacobian[0, 0] * force[0] + jacobian[1, 0] * force[1] + jacobian[2, 0] * force[2]]
-    return (jacobian.T @ np.asarray(force)).tolist()
+    tau: list[float] = (jacobian.T @ np.asarray(force)).tolist()
+    return tau
 
 
-def saturate(effort: ArrayLike, limit: ArrayLike) -> list[float]:
-    """Clip each joint effort to +-limit (scalar or per joint); NaN is refused with ValueError."""
-    e = np.asarray(effort, dtype=np.float64).reshape(-1)
-    lim = np.broadcast_to(np.asarray(limit, dtype=np.float64), e.shape)
-    if not np.all(np.isfinite(e)):
-        raise ValueError(f"effort must be finite, got {e.tolist()}")
-    if np.any(lim <= 0) or not np.all(np.isfinite(lim)):
-        raise ValueError(f"limit must be finite and > 0, got {lim.tolist()}")
-    return np.clip(e, -lim, lim).tolist()
+def saturate(effort: Iterable[float], limit: float | Iterable[float]) -> list[float]:
+    """Clip each joint effort (N or N m) to +-limit: one limit for every joint, or one per joint.
+
+    The suite's one saturation: the device node's command guard clips every command with it.
+    Plain floats, no arrays (it runs on every command of a 1 kHz loop). A non-finite effort, a
+    limit that is not finite and > 0, or per-joint limits of another length: ``ValueError``.
+    """
+    e = [float(x) for x in effort]
+    lim = [float(x) for x in limit] if isinstance(limit, Iterable) else [float(limit)] * len(e)
+    if not all(map(math.isfinite, e)):
+        raise ValueError(f"effort must be finite, got {e}")
+    if not all(0.0 < x < math.inf for x in lim):
+        raise ValueError(f"limit must be finite and > 0, got {lim}")
+    if len(lim) != len(e):
+        raise ValueError(f"need one limit per joint effort ({len(e)}), got {len(lim)}")
+    return [x if -m <= x <= m else (m if x > 0.0 else -m) for x, m in zip(e, lim, strict=True)]
 
 
 class ImpedanceController:
