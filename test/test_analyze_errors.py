@@ -83,7 +83,8 @@ def test_interrupted_recording_without_metadata(good: Path, tmp_path: Path, caps
     (bag / "metadata.yaml").unlink()
     assert error_of([str(bag)], capsys) == (
         f"ERROR: {bag} is truncated or corrupt: the bag directory has no metadata.yaml "
-        "(was the recording killed before it finished?)"
+        f"(was the recording killed before it finished? haptic-record --recover {bag} writes "
+        "what it holds to a new bag)"
     )
 
 

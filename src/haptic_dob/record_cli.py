@@ -5,6 +5,10 @@ SIGTERM or ``--duration``, then prints per topic what it received and wrote. The
 are every session topic and ``/parameter_events``; a snapshot of every node's parameters in the
 namespace goes into the bag too. Start it before the device in lockstep and add its node name to
 the device's ``wait_for`` so the run waits for it and nothing is lost.
+
+The recorder puts what it wrote into complete records on disk at least once a second; after a
+kill -9, a crash or a power cut, ``haptic-record --recover BAG`` writes what is complete (all but
+at most the last second) to a new bag that every tool opens.
 """
 
 from __future__ import annotations
@@ -72,10 +76,26 @@ def main(argv: list[str] | None = None) -> int:
         metavar="HZ",
         help="loop rate, to count missing stamps (default 1000)",
     )
+    p.add_argument(
+        "--recover",
+        metavar="BAG",
+        help="instead of recording: write the complete part of a recording that was killed "
+        "(no metadata.yaml) to a new bag, OUTPUT or BAG_recovered",
+    )
     a = p.parse_args(argv)
+    if a.recover is not None:
+        return run(lambda: recover_command(a.recover, a.output))
     return run(
         lambda: command(a.output, a.storage, a.namespace, a.duration, a.topics, a.node_name, a.rate)
     )
+
+
+def recover_command(bag: str, output: str | None) -> int:
+    """``--recover BAG``: the killed recording's complete records into a new bag."""
+    from haptic_dob.bag.recover import recover
+
+    print(recover(bag, output).summary())
+    return 0
 
 
 if __name__ == "__main__":

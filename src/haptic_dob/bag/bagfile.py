@@ -29,7 +29,8 @@ def check_bag_path(path: Path, shown: str) -> Path:
         if any(path.glob("*.mcap")) or any(path.glob("*.db3")):
             raise BagError(
                 f"{shown} is truncated or corrupt: the bag directory has no metadata.yaml "
-                "(was the recording killed before it finished?)"
+                "(was the recording killed before it finished? haptic-record --recover "
+                f"{shown} writes what it holds to a new bag)"
             )
         raise BagError(f"{shown} is not a bag: a directory without metadata.yaml")
     try:

@@ -11,6 +11,7 @@ any writer (the recorder's too).
 
 from __future__ import annotations
 
+import os
 import struct
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -219,6 +220,27 @@ def open_writer(path: str | Path, storage: str) -> Writer:
     writer = Writer(Path(path), version=9, storage_plugin=plugin)
     writer.open()
     return writer
+
+
+def make_durable(writer: Writer) -> None:
+    """Put everything written so far into complete records on disk, so that a recording killed
+    later (kill -9, a crash, a power cut) keeps it: MCAP closes its pending chunk and flushes and
+    syncs the file, sqlite3 commits. ``haptic-record --recover`` reads such a bag back.
+
+    Uses the storage writer that ``rosbags`` keeps open (``writer.storage``): rosbags offers no
+    public call for it.
+    """
+    storage = writer.storage
+    close_chunk = getattr(storage, "close_chunk", None)
+    if close_chunk is not None:  # MCAP
+        if storage.chunk.bio.tell():  # type: ignore[union-attr]  # the MCAP writer has chunk
+            close_chunk()
+        bio = storage.bio  # type: ignore[union-attr]  # the MCAP writer has bio
+        bio.flush()
+        os.fsync(bio.fileno())
+    conn = getattr(storage, "conn", None)
+    if conn is not None:  # sqlite3
+        conn.commit()
 
 
 @dataclass(frozen=True)

@@ -133,6 +133,7 @@ class RecorderNode(LoopNode):
         sec, nsec = divmod(self.reported_progress_ns(), NS_PER_S)
         self._progress_msg.stamp.sec, self._progress_msg.stamp.nanosec = sec, nsec
         self._progress.publish(self._progress_msg)
+        self.recording.keep_durable()  # at least once a second: a kill -9 loses at most that
 
     # --- parameter snapshots ---------------------------------------------------------------
     def _on_discovery(self) -> None:

@@ -1,9 +1,11 @@
 """The bag being recorded: each message's bytes written as they came, counted per topic.
 
 Bag time is the receive time (wall clock, ns); the analysis times samples by their stamps.
-Parameter snapshots go on ``/parameter_events`` beside the live events. Closing writes the
-counts into the bag's metadata (custom data ``haptic_dob.recorder``) so the bag is readable
-and says what the recorder received and wrote.
+Parameter snapshots go on ``/parameter_events`` beside the live events. At least once a second
+what was written goes into complete records on disk, so a killed recorder loses at most its
+last second (``haptic-record --recover``). Closing writes the counts into the bag's metadata
+(custom data ``haptic_dob.recorder``) so the bag is readable and says what the recorder received
+and wrote.
 """
 
 from __future__ import annotations
@@ -14,13 +16,14 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from haptic_dob.bag.write import open_writer, parameter_event
+from haptic_dob.bag.write import make_durable, open_writer, parameter_event
 from haptic_dob.recorder.counts import RecordingCounts
 from haptic_dob.recorder.topics import PARAMETER_EVENT_TYPE, stamp_reader
 from haptic_msgs_py.topics import PARAMETER_EVENTS
 from haptic_msgs_py.wire import TYPESTORE
 
 METADATA_KEY = "haptic_dob.recorder"  # custom data of the bag's metadata: the counts (JSON)
+DURABLE_EVERY_NS = 1_000_000_000  # complete records on disk at least this often (receive time)
 
 
 class Recording:
@@ -43,6 +46,7 @@ class Recording:
         self.counts = RecordingCounts()
         self.closed = False
         self._events: Any = None  # the /parameter_events connection, if recorded
+        self._durable_ns = time.time_ns()  # when everything written was last made durable
 
     @property
     def records_parameter_events(self) -> bool:
@@ -64,10 +68,25 @@ class Recording:
             count.received += 1
             if self.closed:
                 return
-            write(conn, now(), data)
+            t = now()
+            write(conn, t, data)
             count.wrote(None if stamp_of is None else stamp_of(data), period)
+            if t - self._durable_ns >= DURABLE_EVERY_NS:
+                self._make_durable(t)
 
         return on_message
+
+    def keep_durable(self) -> None:
+        """Call often (a timer): when the last time is ``DURABLE_EVERY_NS`` ago, everything
+        written so far goes into complete records on disk, also while no message comes (a kill -9
+        after that loses none of it; ``haptic-record --recover`` reads it back)."""
+        t = time.time_ns()
+        if not self.closed and t - self._durable_ns >= DURABLE_EVERY_NS:
+            self._make_durable(t)
+
+    def _make_durable(self, now_ns: int) -> None:
+        make_durable(self._writer)
+        self._durable_ns = now_ns
 
     def write_snapshot(
         self, node: str, values: Mapping[str, Any], kinds: Mapping[str, int]

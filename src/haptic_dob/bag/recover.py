@@ -1,0 +1,201 @@
+"""Recover a bag whose recording was killed (kill -9, a crash, a power cut) before it closed.
+
+A rosbag2 directory gets its ``metadata.yaml`` only when the writer closes; an MCAP file gets its
+summary, footer and end magic then too, and a sqlite3 file commits then. The recorder therefore
+closes an MCAP chunk (and flushes it to the operating system) or commits the sqlite3 transaction
+at least once a second (``RecordingWriter``), so a killed recording holds everything but its last
+second in complete records.
+
+``recover`` reads what is complete, without changing the original: for MCAP every record up to the
+first incomplete one (a data-end record and a footer are added to a private copy, which rosbags
+then reads by scanning), for sqlite3 every committed row (the private copy's journal is rolled
+back by sqlite itself). It writes a new, closed bag (same storage, same topics, types and QoS)
+that every tool opens, and says what it recovered.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sqlite3
+import struct
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from haptic_dob.bag.errors import BagError
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+_OP_DATA_END = 0x0F
+_OP_FOOTER = 0x02
+_RECORD_HEAD = 9  # opcode (1 byte) + record length (uint64)
+
+
+@dataclass(frozen=True)
+class Recovery:
+    """What ``recover`` found and wrote."""
+
+    source: Path
+    out: Path
+    storage: str  # "mcap" or "sqlite3"
+    messages: int
+    topics: int
+    duration_s: float  # from the first to the last recovered message
+    dropped_bytes: int  # MCAP: the incomplete tail left out (sqlite3: 0)
+
+    def summary(self) -> str:
+        """One line for the user."""
+        tail = f"; left out an incomplete tail of {self.dropped_bytes} bytes" * bool(
+            self.dropped_bytes
+        )
+        return (
+            f"recovered {self.messages} messages on {self.topics} topics "
+            f"({self.duration_s:.3f} s) from {self.source} into {self.out} "
+            f"({self.storage}){tail}"
+        )
+
+
+def complete_mcap_prefix(data: bytes | memoryview) -> int:
+    """Length (bytes) of the longest prefix of an MCAP file that ends with a complete record
+    before any data-end record: a killed writer's file up to its first incomplete record."""
+    if bytes(data[:8]) != MCAP_MAGIC:
+        raise ValueError("not an MCAP file (no start magic)")
+    pos = len(MCAP_MAGIC)
+    while pos + _RECORD_HEAD <= len(data):
+        op = data[pos]
+        (length,) = struct.unpack_from("<Q", data, pos + 1)
+        end = pos + _RECORD_HEAD + length
+        if op == _OP_DATA_END or end > len(data):
+            break
+        pos = end
+    return pos
+
+
+def closed_mcap(prefix: bytes | memoryview) -> bytes:
+    """``prefix`` (complete records) closed as a valid MCAP file without a summary section."""
+    data_end = bytes([_OP_DATA_END]) + struct.pack("<QI", 4, 0)  # data section CRC 0: unchecked
+    footer = bytes([_OP_FOOTER]) + struct.pack("<QQQI", 20, 0, 0, 0)  # no summary section
+    return bytes(prefix) + data_end + footer + MCAP_MAGIC
+
+
+def storage_file(bag: Path, shown: str) -> tuple[Path, str]:
+    """The one storage file of a bag directory (or the file given) and its storage name."""
+    if bag.is_file():
+        files = [bag]
+    elif bag.is_dir():
+        files = sorted(bag.glob("*.mcap")) + sorted(bag.glob("*.db3"))
+    else:
+        raise BagError(f"{shown}: no such file or directory")
+    if not files:
+        raise BagError(f"{shown} holds no .mcap or .db3 file: nothing to recover")
+    if len(files) > 1:
+        raise BagError(f"{shown} holds {len(files)} storage files; recover them one at a time")
+    path = files[0]
+    if path.suffix == ".mcap":
+        return path, "mcap"
+    if path.suffix == ".db3":
+        return path, "sqlite3"
+    raise BagError(f"{shown}: {path.name} is neither .mcap nor .db3")
+
+
+def _copy_readable(path: Path, storage: str, work: Path) -> tuple[Path, int]:
+    """A private copy of the storage file that rosbags' storage reader opens, and the bytes
+    left out."""
+    if storage == "mcap":
+        data = path.read_bytes()
+        try:
+            end = complete_mcap_prefix(data)
+        except ValueError as exc:
+            raise BagError(f"{path}: {exc}") from None
+        copy = work / path.name
+        copy.write_bytes(closed_mcap(memoryview(data)[:end]))
+        return copy, len(data) - end
+    copy = work / path.name
+    for sibling in path.parent.glob(path.name + "*"):  # the file and its -journal / -wal
+        shutil.copy2(sibling, work / sibling.name)
+    try:  # a read-write open rolls back a hot journal (or replays a WAL), as sqlite does
+        with sqlite3.connect(copy) as db:
+            db.execute("SELECT count(*) FROM sqlite_master").fetchone()
+        db.close()
+    except sqlite3.DatabaseError as exc:
+        raise BagError(f"{path}: not a readable sqlite3 database ({exc})") from None
+    return copy, 0
+
+
+def _reader(copy: Path, storage: str) -> Any:
+    """rosbags' storage-level reader of one file (no metadata.yaml needed)."""
+    if storage == "mcap":
+        from rosbags.rosbag2.storage_mcap import McapReader
+
+        return McapReader(copy)
+    from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader
+
+    return Sqlite3Reader(copy)
+
+
+def _typestore(conns: list[Any], path: Path) -> Any:
+    """Jazzy's typestore, with any type of ``conns`` it lacks read from the bag's definition."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    typestore = get_typestore(Stores.ROS2_JAZZY)
+    for c in conns:
+        if c.msgtype not in typestore.fielddefs:
+            try:
+                typestore.register(get_types_from_msg(c.msgdef.data, c.msgtype))
+            except Exception as exc:  # rosbags raises several kinds on a foreign definition
+                raise BagError(f"{path}: cannot read the type {c.msgtype} ({exc})") from None
+    return typestore
+
+
+def recover(bag: str | Path, out: str | Path | None = None) -> Recovery:
+    """Write the complete part of the killed recording ``bag`` to a new bag ``out`` (default:
+    ``<bag>_recovered``). Raises ``BagError`` (one line) when there is nothing to recover."""
+    from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
+    from rosbags.rosbag2.errors import ReaderError
+
+    bag = Path(bag)
+    if (bag / "metadata.yaml").is_file():
+        raise BagError(f"{bag} has its metadata.yaml: it was closed, there is nothing to recover")
+    path, storage = storage_file(bag, str(bag))
+    target = Path(out) if out is not None else bag.with_name(bag.name + "_recovered")
+    if target.exists():
+        raise BagError(f"{target} exists; give another output path or remove it")
+    with tempfile.TemporaryDirectory(prefix="haptic-recover-") as tmp:
+        copy, dropped = _copy_readable(path, storage, Path(tmp))
+        reader = _reader(copy, storage)
+        try:
+            reader.open()
+        except (ReaderError, OSError, ValueError, AssertionError) as exc:
+            raise BagError(f"{path}: nothing readable to recover ({exc})") from None
+        try:
+            conns = list(reader.connections)
+            if not conns:
+                raise BagError(f"{path}: no complete topic record (killed in its first second?)")
+            plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+            writer = Writer(target, version=9, storage_plugin=plugin)
+            try:
+                writer.open()
+            except (WriterError, OSError) as exc:
+                raise BagError(f"{target}: cannot create the recovered bag ({exc})") from None
+            typestore = _typestore(conns, path)
+            added = {
+                c.id: writer.add_connection(
+                    c.topic,
+                    c.msgtype,
+                    typestore=typestore,
+                    serialization_format=c.ext.serialization_format,
+                    offered_qos_profiles=c.ext.offered_qos_profiles,
+                )
+                for c in conns
+            }
+            count, first, last = 0, None, None
+            for conn, stamp, data in reader.messages(conns):
+                writer.write(added[conn.id], stamp, data)
+                count += 1
+                first = stamp if first is None else first
+                last = stamp
+            writer.close()
+        finally:
+            reader.close()
+    span = (last - first) * 1e-9 if first is not None and last is not None else 0.0
+    return Recovery(bag, target, storage, count, len(conns), span, dropped)
