@@ -37,6 +37,12 @@ def test_oblique_normal_is_normalised() -> None:
     np.testing.assert_allclose(f, -100.0 * (0.02 / np.sqrt(2)) * n)
 
 
+def test_a_huge_normal_is_a_direction_too() -> None:
+    """Entries whose squares overflow (a fuzzed parameter found it) still give the unit normal."""
+    for normal, unit in (((0.0, 0.0, 1.34e154), (0.0, 0.0, 1.0)), ((-1e308, 0.0, 0.0), (-1, 0, 0))):
+        assert VirtualWall(normal=normal).normal == pytest.approx(unit)
+
+
 def test_desired_impedance() -> None:
     z = VirtualWall(800.0, 2.0).desired_impedance([0.0, 1.0])
     np.testing.assert_allclose(z, [800.0, 800.0 + 2j * 2.0 * np.pi])

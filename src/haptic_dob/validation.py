@@ -58,9 +58,13 @@ def vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64]:
 def unit_vector(name: str, value: ArrayLike, size: int = 3) -> NDArray[np.float64]:
     """Return ``value`` normalised to unit length; a zero vector raises ``ValueError``."""
     arr = vector(name, value, size)
-    norm = float(np.linalg.norm(arr))
+    with np.errstate(over="ignore"):
+        norm = float(np.linalg.norm(arr))
     if norm < 1e-12:
         raise ValueError(f"{name} must be a non-zero vector, got {arr.tolist()}")
+    if not np.isfinite(norm):  # finite entries whose squares overflow: scale them first
+        scaled = arr / np.max(np.abs(arr))
+        return scaled / float(np.linalg.norm(scaled))
     return arr / norm
 
 
