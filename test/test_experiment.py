@@ -18,7 +18,9 @@ import pytest
 
 from conftest import tool
 from haptic_sim.experiments import dob, results
+from haptic_sim.experiments.parts import CH7, load_results
 from haptic_sim.experiments.plan import chapter6_runs, chapter7_runs
+from haptic_sim.experiments.records import Cell, ExperimentResults, RunAnalysis
 from haptic_sim.session import SessionConfig
 from haptic_sim.stability import law_for
 
@@ -63,8 +65,9 @@ def test_quick_experiment_runs_through_the_graph_resumes_and_haptic_analyze_repr
     # half-way is neither reported nor kept)
     finished = sum(line.startswith("[  ") for line in seen)
     assert f"{finished} of 3 runs already recorded (resuming)" in p.stdout, "".join(seen) + p.stdout
-    res = json.loads((out / "results.json").read_text())
-    assert {(r["mode"], r["kf"], r["wall"]) for r in res["ch7"]} == {
+    ch7 = CH7.result_in(load_results(out / "results.json"))
+    assert ch7 is not None
+    assert {(r.mode, r.kf, r.wall) for r in ch7.rows} == {
         ("OL", 0.0, 800.0),
         ("CL", 2.0, 800.0),
         ("DOB", 1.0, 800.0),
@@ -73,30 +76,30 @@ def test_quick_experiment_runs_through_the_graph_resumes_and_haptic_analyze_repr
     assert "| OL |" in report and "Table 7.1" in report
     assert (out / "figures" / "ch7_transparency.png").stat().st_size > 10_000
     # every number comes from the bag: haptic-analyze on it prints the same figures
-    for row in res["ch7"]:
-        assert row["segments"] == 1 and row["problem"] is None
-        assert row["duration_s"] > 19.9  # the whole 20 s session is in the bag
+    for row in ch7.rows:
+        assert row.segments == 1 and row.problem is None
+        assert row.duration_s is not None and row.duration_s > 19.9  # the whole 20 s session
         a = subprocess.run(
-            [tool("haptic-analyze"), row["bag"], "--json"],
+            [tool("haptic-analyze"), row.bag, "--json"],
             capture_output=True,
             text=True,
             timeout=120,
         )
         assert a.returncode == 0, a.stderr
         (seg,) = json.loads(a.stdout)
-        assert seg["controller"] == row["mode"] and seg["kf"] == row["kf"]
-        assert seg["stiffness_n_per_m"] == row["wall"]
-        assert seg["bandwidth_hz"] == row["bandwidth_hz"]
-        assert seg["impedance_error_pct"] == row["impedance_error_pct"]
+        assert seg["controller"] == row.mode and seg["kf"] == row.kf
+        assert seg["stiffness_n_per_m"] == row.wall
+        assert seg["bandwidth_hz"] == row.bandwidth_hz
+        assert seg["impedance_error_pct"] == row.impedance_error_pct
     # the thesis's ordering at 800 N/m: force feedback widens the band
-    bw = {r["mode"]: r["bandwidth_hz"] for r in res["ch7"]}
+    bw = {r.mode: r.bandwidth_hz for r in ch7.rows}
     assert bw["CL"] > bw["OL"] and bw["DOB"] > bw["OL"]
     # once everything is recorded, nothing runs again
     again = subprocess.run(argv, capture_output=True, text=True, timeout=120)
     assert again.returncode == 0, again.stderr
     assert "3 of 3 runs already recorded" in again.stdout
     assert "node-graph runs" in again.stdout and "simulated in" not in again.stdout
-    assert json.loads((out / "results.json").read_text())["ch7"] == res["ch7"]
+    assert CH7.result_in(load_results(out / "results.json")) == ch7
 
 
 @pytest.mark.parametrize(
@@ -140,24 +143,33 @@ def test_the_plan_holds_the_thesis_cells(root) -> None:
     assert len({r.name for r in ch7}) == 16
     for r in ch7:  # OL and CL leave the observer out; DOB waits for it
         has_observer = "observer_node" in r.params
-        assert has_observer == (r.meta["mode"] == "DOB")
+        assert has_observer == (r.cell.mode == "DOB")
         assert ("observer_node" in r.params["device_node"]["wait_for"]) == has_observer
     ch6 = chapter6_runs(config)
-    walls = {m: sorted(r.meta["wall"] for r in ch6 if r.meta["mode"] == m) for m in ["OL", "CL"]}
+    walls = {m: sorted(r.cell.wall for r in ch6 if r.cell.mode == m) for m in ["OL", "CL"]}
     # the walls bracket the bounds 2544 (OL) and 848 (CL Kf=2) N/m
     assert any(w < 2544 for w in walls["OL"]) and any(w > 2544 for w in walls["OL"])
     assert any(w < 848 for w in walls["CL"]) and any(w > 848 for w in walls["CL"])
     assert all(r.params["/**"]["slide.coulomb_n"] == 0.0 for r in ch6)
 
 
-def _row(mode: str, kf: float, wall: float, growth: float | None, vib: bool) -> dict:
-    return {
-        "mode": mode,
-        "kf": kf,
-        "wall": wall,
-        "perturbation_growth_per_s": growth,
-        "perturbation_vibrates": vib,
-    }
+def _row(mode: str, kf: float, wall: float, growth: float | None, vib: bool) -> RunAnalysis:
+    return RunAnalysis(
+        "ch6",
+        mode,
+        kf,
+        wall,
+        f"ch6_{mode}_{wall:g}",
+        1,
+        "bag",
+        perturbation_growth_per_s=growth,
+        perturbation_vibrates=vib,
+    )
+
+
+def _ch7_row(mode: str, kf: float, wall: float, bandwidth_hz: float) -> RunAnalysis:
+    name = f"ch7_{mode}_{wall:g}"
+    return RunAnalysis("ch7", mode, kf, wall, name, 1, "bag", bandwidth_hz=bandwidth_hz)
 
 
 def test_ch6_onset_is_the_interpolated_zero_crossing_of_the_growth_rate() -> None:
@@ -167,71 +179,73 @@ def test_ch6_onset_is_the_interpolated_zero_crossing_of_the_growth_rate() -> Non
         _row("CL", 2.0, 800.0, None, True),  # already vibrating before the pulse
         _row("DOB", 100.0, 800.0, -0.5, False),
     ]
-    on = results.ch6_onsets(rows)
-    assert on["OL"]["onset_n_per_m"] == pytest.approx(2400.0 + 400.0 / 3.0)
-    assert [p["wall"] for p in on["OL"]["points"]] == [2400.0, 2800.0]
-    assert on["CL Kf=2"]["onset_n_per_m"] == 800.0 and on["CL Kf=2"]["first_point_vibrates"]
-    assert on["DOB Kf=100"]["onset_n_per_m"] is None
-    checks = {text.split(" onset")[0]: ok for text, ok in results.ch6_checks(on, 1.272, 1000.0)}
-    assert checks == {"OL": True, "CL Kf=2": False}  # OL 2533 vs 2544; CL below the range
+    onsets = results.ch6_onsets(rows)
+    on = {e.controller: e for e in onsets}
+    assert on["OL"].onset_n_per_m == pytest.approx(2400.0 + 400.0 / 3.0)
+    assert [p.wall for p in on["OL"].points] == [2400.0, 2800.0]
+    assert on["CL Kf=2"].onset_n_per_m == 800.0 and on["CL Kf=2"].first_point_vibrates
+    assert on["DOB Kf=100"].onset_n_per_m is None
+    checks = results.ch6_checks(onsets, 1.272, 1000.0)
+    # OL 2533 vs 2544; CL below the range
+    assert {c.text.split(" onset")[0]: c.passed for c in checks} == {"OL": True, "CL Kf=2": False}
 
 
 def test_ch7_checks_compare_with_the_thesis_and_with_ol() -> None:
     rows = [
-        {"mode": "OL", "kf": 0.0, "wall": 800.0, "bandwidth_hz": 4.5},  # 3.8 Hz +- 15 %: no
-        {"mode": "OL", "kf": 0.0, "wall": 1600.0, "bandwidth_hz": 5.0},
-        {"mode": "CL", "kf": 2.0, "wall": 800.0, "bandwidth_hz": 5.0},
-        {"mode": "DOB", "kf": 1.0, "wall": 800.0, "bandwidth_hz": 4.0},
+        _ch7_row("OL", 0.0, 800.0, 4.5),  # 3.8 Hz +- 15 %: no
+        _ch7_row("OL", 0.0, 1600.0, 5.0),
+        _ch7_row("CL", 2.0, 800.0, 5.0),
+        _ch7_row("DOB", 1.0, 800.0, 4.0),
     ]
     checks = results.ch7_checks(rows)
-    assert [ok for _, ok in checks] == [False, True, True, False]
+    assert [c.passed for c in checks] == [False, True, True, False]
 
 
 def test_report_renders_every_section(tmp_path) -> None:
     from haptic_sim.experiments import report
 
     base = SessionConfig()
-    res = {
-        "config": "slide_sim",
-        "quick": False,
-        "seed": 0,
-        "parts": ["ch7", "ch6", "dob"],
-        "ch7": [
-            {
-                "mode": "OL",
-                "kf": 0.0,
-                "wall": w,
-                "bandwidth_hz": 1.0 + w / 1000.0,
-                "impedance_error_pct": 20.0,
-                "band_limited_by_fmax": False,
-                "vibrating": False,
-            }
-            for w in (80.0, 800.0)
-        ],
-        "ch6": [_row("OL", 0.0, 2400.0, -0.1, False), _row("OL", 0.0, 2800.0, 0.2, True)],
-        "dob": {
-            "kick": [
-                {
-                    "stiffness_n_per_m": w,
-                    "gain": 2.0,
-                    "coulomb_n": 0.24,
-                    "residual_rms_m": r,
-                    "frequency_hz": 40.0,
-                    "vibrates": r > dob.VIBRATION_RMS_M,
-                }
-                for w, r in zip(dob.WALLS, [0, 0, 0, 0, 7e-5, 9e-5], strict=True)
-            ],
-            "first_vibrating": [{"gain": 2.0, "coulomb_n": 0.24, "wall": 3200.0}],
-            "linear": [
-                {"kf": 100.0, "gain": 2.0, "dob_onset_n_per_m": 0.0, "cl_onset_n_per_m": 26.0}
-            ],
-            "bandwidth_vs_gain": [{"gain": 2.0, "bandwidth_hz": 1.2, "impedance_error_pct": 48.0}],
+    ch7 = [
+        RunAnalysis(
+            "ch7",
+            "OL",
+            0.0,
+            w,
+            f"ch7_OL_{w:g}",
+            1,
+            "bag",
+            bandwidth_hz=1.0 + w / 1000.0,
+            impedance_error_pct=20.0,
+            band_limited_by_fmax=False,
+            vibrating=False,
+        )
+        for w in (80.0, 800.0)
+    ]
+    ch6 = [_row("OL", 0.0, 2400.0, -0.1, False), _row("OL", 0.0, 2800.0, 0.2, True)]
+    kick = [
+        dob.KickPoint(w, 2.0, 0.24, r, 40.0)
+        for w, r in zip(dob.WALLS, [0, 0, 0, 0, 7e-5, 9e-5], strict=True)
+    ]
+    study = dob.DobStudy(
+        kick,
+        [dob.FirstVibrating(2.0, 0.24, dob.first_vibrating(kick, 2.0, 0.24))],
+        [dob.LinearOnset(100.0, 2.0, 0.0, 26.0)],
+        [dob.GainBandwidth(2.0, 1.0, 800.0, 1.2, 48.0)],
+        [],
+    )
+    res = ExperimentResults(
+        config="slide_sim",
+        config_params={},
+        quick=False,
+        seed=0,
+        parts=["ch7", "ch6", "dob"],
+        results={
+            "ch7": results.ch7_result(ch7),
+            "ch6": results.ch6_result(ch6, base),
+            "dob": study,
         },
-        "timing_s": {"total": 1.0},
-    }
-    res["ch6_onsets"] = results.ch6_onsets(res["ch6"])
-    res["ch6_checks"] = results.ch6_checks(res["ch6_onsets"], 1.272, 1000.0)
-    res["ch7_checks"] = results.ch7_checks(res["ch7"])
+        timing_s={"total": 1.0},
+    )
     path = report.write(tmp_path, res, base)
     text = path.read_text()
     assert "| OL | 1.08 / 1.3 | 1.80 / 3.8 |" in text  # simulation beside thesis Table 7.1
@@ -265,11 +279,12 @@ def test_a_recorded_run_counts_only_with_the_same_parameters(tmp_path) -> None:
         run_dir,
     )
 
-    run = GraphRun("r", {"device_node": {"duration_s": 1.0}})
+    cell = Cell("ch7", "OL", 0.0, 800.0)
+    run = GraphRun("r", {"device_node": {"duration_s": 1.0}}, cell)
     bag_path(tmp_path, run).mkdir(parents=True)
     assert not is_complete(tmp_path, run)  # interrupted: no marker
     marker = {"wall_s": 1.0, "params_digest": params_digest(run)}
     (run_dir(tmp_path, run) / COMPLETE).write_text(json.dumps(marker))
     assert is_complete(tmp_path, run)
-    changed = GraphRun("r", {"device_node": {"duration_s": 2.0}})
+    changed = GraphRun("r", {"device_node": {"duration_s": 2.0}}, cell)
     assert not is_complete(tmp_path, changed)

@@ -25,22 +25,53 @@ import shutil
 import signal
 import sys
 import time
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from haptic_dob.cli import ArgumentParser, CliError, run
+from haptic_dob.configs import resolve_config
+from haptic_dob.runtime.cpus import free_cpus, workers_for
+from haptic_sim.experiments import graph_runs, report, results
+from haptic_sim.experiments.jsonio import from_json, to_json
+from haptic_sim.experiments.parts import (
+    EXPERIMENTS,
+    PARTS,
+    QUICK_PARTS,
+    BatchJob,
+    Experiment,
+    GraphJob,
+    save_results,
+)
+from haptic_sim.experiments.plan import QUICK_DURATION_S
+from haptic_sim.experiments.records import ExperimentResults
+from haptic_sim.session import SessionConfig
 
-PARTS = ("ch7", "ch6", "map", "dob", "phantom")
 #: busy processes of one recorded graph run: the composed loop and the recorder
 GRAPH_RUN_PROCESSES = 2
-QUICK_CONTROLLERS = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0)]
-QUICK_WALLS = [800.0]
-QUICK_DURATION_S = 20.0
-#: stability map: Kf values (B = 0) and the Z-width's wall dampings (N s/m)
-MAP_KFS = [0.5, 1.0, 2.0, 5.0, 10.0, 25.0, 100.0]
-ZWIDTH_CONTROLLERS = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0)]
-ZWIDTH_DAMPINGS = [0.0, 0.25, 0.5, 1.0]
+
+R = TypeVar("R")
+
+
+@dataclass(frozen=True)
+class Setting:
+    """What one ``haptic-experiment`` works with: where, from which config, how many at a time."""
+
+    root: Path  # --out
+    config_path: Path
+    base: SessionConfig
+    seed: int
+    quick: bool
+    graph_workers: int  # graph runs at a time
+    batch_workers: int  # batch jobs (and bag analyses) at a time
+
+    @property
+    def figures(self) -> Path:
+        """The report's figure directory."""
+        return self.root / "figures"
 
 
 def _say(text: str) -> None:
@@ -55,14 +86,72 @@ def _parts(text: str) -> list[str]:
     return parts
 
 
-def _cached(path: Path, compute: Any) -> Any:
+def _cached(path: Path, result_type: type[R], compute: Callable[[], R]) -> R:
     """Batch results are kept in ``path`` (JSON) so that a resumed experiment skips them."""
     if path.is_file():
-        return json.loads(path.read_text(encoding="utf-8"))
+        try:
+            return from_json(result_type, json.loads(path.read_text(encoding="utf-8")))
+        except ValueError as exc:
+            raise CliError(f"{path}: {exc} (delete it, or start over with --fresh)") from None
     value = compute()
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(value, indent=1) + "\n", encoding="utf-8")
+    path.write_text(json.dumps(to_json(value), indent=1) + "\n", encoding="utf-8")
     return value
+
+
+def run_batch(
+    chosen: list[Experiment[Any]], s: Setting, timing: dict[str, float]
+) -> dict[str, Any]:
+    """The chosen batch parts' results (cached in ``batch/``), their run-time figures drawn."""
+    batch = [(e, e.job) for e in chosen if isinstance(e.job, BatchJob)]
+    out: dict[str, Any] = {}
+    if not batch:
+        return out
+    with ProcessPoolExecutor(s.batch_workers) as pool:
+        for e, job in batch:
+            t0 = time.monotonic()
+            compute = partial(job.compute, s.base, pool, s.figures)
+            out[e.part] = _cached(s.root / "batch" / f"{e.part}.json", e.result_type, compute)
+            timing[e.part] = time.monotonic() - t0
+            _say(f"{job.done(out[e.part])} ({timing[e.part]:.0f} s)")
+    for e, _ in batch:
+        for f in e.figures:
+            if f.simulate is not None and not (s.figures / f.file).is_file():
+                f.simulate(s.base, s.figures / f.file)
+    return out
+
+
+def run_graph(
+    chosen: list[Experiment[Any]], s: Setting, timing: dict[str, float]
+) -> dict[str, Any]:
+    """The chosen graph parts' results: every run recorded (or resumed), analysed, collected."""
+    planned = [
+        (e, e.job, e.job.runs(s.config_path, s.seed, s.quick))
+        for e in chosen
+        if isinstance(e.job, GraphJob)
+    ]
+    runs = [r for _, _, rs in planned for r in rs]
+    if not runs:
+        return {}
+    t0 = time.monotonic()
+    sim = sum(r.duration_s for r in runs)
+    _say(f"{len(runs)} node-graph runs ({sim:g} s simulated), {s.graph_workers} at a time")
+    try:
+        graph_runs.execute_all(s.root, runs, s.graph_workers, rtf_guess=1.0, progress=_say)
+    except RuntimeError as exc:
+        raise CliError(str(exc).splitlines()[0] + " (see its launch.log)") from None
+    timing["graph_runs"] = time.monotonic() - t0
+    t0 = time.monotonic()
+    with ProcessPoolExecutor(s.batch_workers) as pool:
+        rows = list(pool.map(results.analyse_run, [s.root] * len(runs), runs))
+    timing["analysis"] = time.monotonic() - t0
+    _say(f"analysed {len(rows)} bags ({timing['analysis']:.0f} s)")
+    out: dict[str, Any] = {}
+    first = 0
+    for e, job, part_runs in planned:
+        out[e.part] = job.collect(rows[first : first + len(part_runs)], s.base)
+        first += len(part_runs)
+    return out
 
 
 def command(
@@ -75,34 +164,21 @@ def command(
     fresh: bool,
 ) -> int:
     """Run the chosen parts, analyse, write the report; raises on bad input or a failed run."""
-    from haptic_dob.configs import resolve_config
-    from haptic_dob.runtime.cpus import free_cpus, workers_for
-    from haptic_sim.experiments import graph_runs, plan, report, results
-    from haptic_sim.session import SessionConfig
-
     if workers is not None and workers < 1:
         raise CliError(f"--workers must be >= 1, got {workers}")
     if seed < 0:
         raise CliError(f"--seed must be >= 0, got {seed}")
-    parts = ["ch7"] if quick else _parts(parts_text)
+    parts = QUICK_PARTS if quick else _parts(parts_text)
+    chosen = [e for e in EXPERIMENTS if e.part in parts]
     config_path = resolve_config(config)
     root = Path(out)
     if fresh and root.exists():
         if not (root / "results.json").is_file() and not (root / "runs").is_dir():
             raise CliError(f"--fresh: {root} does not look like an experiment directory")
         shutil.rmtree(root)
-    root.mkdir(parents=True, exist_ok=True)
-    (root / "figures").mkdir(exist_ok=True)
+    (root / "figures").mkdir(parents=True, exist_ok=True)
     base = SessionConfig.from_yaml(config_path)
     t_start = time.monotonic()
-    timing: dict[str, float] = {}
-    res: dict[str, Any] = {
-        "config": str(config),
-        "config_params": graph_runs.session_params(config_path, {}),
-        "quick": quick,
-        "seed": seed,
-        "parts": parts,
-    }
     if workers is None:
         free = free_cpus()
         graph_workers, batch_workers = workers_for(GRAPH_RUN_PROCESSES, free), workers_for(1, free)
@@ -114,111 +190,26 @@ def command(
         f"haptic-experiment: {', '.join(parts)} -> {root}/ ({graph_workers} graph run(s) and "
         f"{batch_workers} batch job(s) at a time: {basis})"
     )
-
-    # --- batch parts first (they use every core for a short while) -----------------------------
-    batch = [p for p in parts if p in ("map", "dob", "phantom")]
-    if batch:
-        with ProcessPoolExecutor(batch_workers) as ex:
-            if "map" in parts:
-                t0 = time.monotonic()
-                res["map"] = _cached(root / "batch" / "map.json", lambda: _map(base, ex))
-                timing["map"] = time.monotonic() - t0
-                _say(f"stability map: {len(res['map'])} onsets ({timing['map']:.0f} s)")
-            if "dob" in parts:
-                t0 = time.monotonic()
-                res["dob"] = _cached(root / "batch" / "dob.json", lambda: _dob(base, ex))
-                timing["dob"] = time.monotonic() - t0
-                _say(f"DOB mechanism study: done ({timing['dob']:.0f} s)")
-        if "phantom" in parts:
-            from haptic_sim.thesis52 import reproduce_free_motion, reproduce_wall
-
-            t0 = time.monotonic()
-            figs = root / "figures"
-            res["phantom"] = _cached(
-                root / "batch" / "phantom.json",
-                lambda: {
-                    "5.2.1": reproduce_free_motion(figs),
-                    "5.2.2": reproduce_wall(figs),
-                },
-            )
-            timing["phantom"] = time.monotonic() - t0
-            _say(f"PHANToM section 5.2: done ({timing['phantom']:.0f} s)")
-        if "dob" in parts and not (root / "figures" / "dob_kick_traces.png").is_file():
-            from haptic_sim.experiments import dob
-
-            dob.plot_traces(
-                dob.traces(base, 1600.0), 1600.0, root / "figures" / "dob_kick_traces.png"
-            )
-
-    # --- graph runs -----------------------------------------------------------------------------
-    runs = []
-    if "ch7" in parts:
-        if quick:
-            runs += plan.chapter7_runs(
-                config_path, seed, QUICK_DURATION_S, QUICK_CONTROLLERS, QUICK_WALLS
-            )
-        else:
-            runs += plan.chapter7_runs(config_path, seed)
-    if "ch6" in parts:
-        runs += plan.chapter6_runs(config_path)
-    if runs:
-        t0 = time.monotonic()
-        sim = sum(r.duration_s for r in runs)
-        _say(f"{len(runs)} node-graph runs ({sim:g} s simulated), {graph_workers} at a time")
-        try:
-            graph_runs.execute_all(root, runs, graph_workers, rtf_guess=1.0, progress=_say)
-        except RuntimeError as exc:
-            raise CliError(str(exc).splitlines()[0] + " (see its launch.log)") from None
-        timing["graph_runs"] = time.monotonic() - t0
-        t0 = time.monotonic()
-        with ProcessPoolExecutor(batch_workers) as ex:
-            rows = list(ex.map(results.analyse_run, [root] * len(runs), runs))
-        timing["analysis"] = time.monotonic() - t0
-        _say(f"analysed {len(rows)} bags ({timing['analysis']:.0f} s)")
-        res["ch7"] = [r for r in rows if r["part"] == "ch7"]
-        res["ch6"] = [r for r in rows if r["part"] == "ch6"]
-        res["ch7_checks"] = results.ch7_checks(res["ch7"])
-        if res["ch6"]:
-            res["ch6_onsets"] = results.ch6_onsets(res["ch6"])
-            res["ch6_checks"] = results.ch6_checks(
-                res["ch6_onsets"], base.model.viscous_n_s_per_m, base.loop.rate_hz
-            )
+    s = Setting(root, config_path, base, seed, quick, graph_workers, batch_workers)
+    timing: dict[str, float] = {}
+    # the batch parts first: they use every core for a short while
+    outputs = run_batch(chosen, s, timing)
+    outputs.update(run_graph(chosen, s, timing))
     timing["total"] = time.monotonic() - t_start
-    res["timing_s"] = timing
-    (root / "results.json").write_text(json.dumps(res, indent=1) + "\n", encoding="utf-8")
+    res = ExperimentResults(
+        config=str(config),
+        config_params=graph_runs.session_params(config_path, {}),
+        quick=quick,
+        seed=seed,
+        parts=parts,
+        results=outputs,
+        timing_s=timing,
+    )
+    save_results(root / "results.json", res)
     path = report.write(root, res, base)
     _say(report.console_summary(res))
     _say(f"report: {path} (total {timing['total']:.0f} s)")
     return 0
-
-
-def _map(base: Any, executor: Any) -> list[dict]:
-    from haptic_sim.experiments.zwidth import stability_map
-
-    controllers = [("OL", 0.0)] + [(m, kf) for m in ("CL", "DOB") for kf in MAP_KFS]
-    points = stability_map(controllers, [0.0], base, executor=executor)
-    extra = stability_map(
-        ZWIDTH_CONTROLLERS, [d for d in ZWIDTH_DAMPINGS if d != 0.0], base, executor=executor
-    )
-    return [p.as_dict() for p in points + extra]
-
-
-def _dob(base: Any, executor: Any) -> dict[str, Any]:
-    from haptic_sim.experiments import dob
-
-    kick = dob.kick_grid(base, executor=executor)
-    return {
-        "kick": dob.as_dicts(kick),
-        "first_vibrating": [
-            {"gain": c, "coulomb_n": fc, "wall": dob.first_vibrating(kick, c, fc)}
-            for c, fc in dob.KNOBS
-        ],
-        "linear": dob.linear_onsets(base, [2.0, 10.0, 41.6], [1.0, 2.0, 25.0, 100.0]),
-        "bandwidth_vs_gain": dob.bandwidth_vs_gain(
-            base, dob.GAINS_FOR_BANDWIDTH, executor=executor
-        ),
-        "model_mismatch": dob.model_mismatch(base, executor=executor),
-    }
 
 
 def main(argv: list[str] | None = None) -> int:

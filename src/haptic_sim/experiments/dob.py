@@ -23,9 +23,8 @@ trend, and its dominant frequency); a wall vibrates when that exceeds ``VIBRATIO
 from __future__ import annotations
 
 from concurrent.futures import Executor
-from dataclasses import asdict, dataclass
-from pathlib import Path
-from typing import Any
+from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from scipy import signal
@@ -42,6 +41,11 @@ WALLS = [400.0, 800.0, 1600.0, 2400.0, 3200.0, 4000.0]
 #: (observer gain c in N s/m, Coulomb friction in N) combinations of the grid
 KNOBS = [(2.0, 0.24), (2.0, 0.0), (41.6, 0.24), (41.6, 0.0)]
 GAINS_FOR_BANDWIDTH = [2.0, 5.0, 10.0, 20.0, 41.6]
+#: the linear model's table: observer gains c (N s/m) for each Kf
+LINEAR_GAINS = [2.0, 10.0, 41.6]
+LINEAR_KFS = [1.0, 2.0, 25.0, 100.0]
+#: the wall (N/m) of the stick-or-chatter traces
+TRACES_WALL = 1600.0
 
 
 @dataclass(frozen=True)
@@ -87,10 +91,72 @@ class KickPoint:
     residual_rms_m: float
     frequency_hz: float
 
+    JSON_DERIVED: ClassVar[tuple[str, ...]] = ("vibrates",)
+
     @property
     def vibrates(self) -> bool:
         """True when the motion is still there 2-3 s after the kick."""
         return self.residual_rms_m > VIBRATION_RMS_M
+
+
+@dataclass(frozen=True)
+class FirstVibrating:
+    """The lowest wall (N/m) that vibrates in one (c, Coulomb) row of the grid; None if none."""
+
+    gain: float
+    coulomb_n: float
+    wall: float | None
+
+
+@dataclass(frozen=True)
+class LinearOnset:
+    """The linear model's lowest unstable wall (N/m; 0: any, None: stable) at one Kf and c."""
+
+    kf: float
+    gain: float
+    dob_onset_n_per_m: float | None
+    cl_onset_n_per_m: float | None  # CL with an ideal sensor, for comparison
+
+
+@dataclass(frozen=True)
+class GainBandwidth:
+    """DOB transparency (batch, the chapter-7 hand) at one observer gain c (N s/m)."""
+
+    gain: float
+    kf: float
+    wall: float
+    bandwidth_hz: float | None
+    impedance_error_pct: float | None
+
+
+@dataclass(frozen=True)
+class MismatchCell:
+    """DOB transparency at one wall and Kf with one observer model (``exact``, ``no Coulomb``)."""
+
+    wall: float
+    kf: float
+    observer_model: str
+    bandwidth_hz: float | None
+    impedance_error_pct: float | None
+
+
+@dataclass(frozen=True)
+class DobStudy:
+    """The dob part's result: the kick grid, its first vibrating walls, the linear model, and
+    the transparency against the observer gain and with a mismatched observer model."""
+
+    kick: list[KickPoint]
+    first_vibrating: list[FirstVibrating]
+    linear: list[LinearOnset]
+    bandwidth_vs_gain: list[GainBandwidth]
+    model_mismatch: list[MismatchCell]
+
+    def first_wall(self, gain: float, coulomb_n: float) -> float | None:
+        """The first vibrating wall (N/m) of one (c, Coulomb) row; None if none or not run."""
+        return next(
+            (r.wall for r in self.first_vibrating if r.gain == gain and r.coulomb_n == coulomb_n),
+            None,
+        )
 
 
 def residual(x: np.ndarray, rate_hz: float, start_s: float, end_s: float) -> tuple[float, float]:
@@ -148,22 +214,15 @@ def first_vibrating(points: list[KickPoint], gain: float, coulomb_n: float) -> f
     return next((p.stiffness_n_per_m for p in row if p.vibrates), None)
 
 
-def linear_onsets(base: SessionConfig, gains: list[float], kfs: list[float]) -> list[dict]:
+def linear_onsets(base: SessionConfig, gains: list[float], kfs: list[float]) -> list[LinearOnset]:
     """The linear model's DOB onsets (N/m) against c for each Kf, with the CL bound, no grip."""
     m, b = base.model.mass_kg, base.model.viscous_n_s_per_m
     T = 1.0 / base.loop.rate_hz
-    rows = []
-    for kf in kfs:
-        for c in gains:
-            rows.append(
-                {
-                    "kf": kf,
-                    "gain": c,
-                    "dob_onset_n_per_m": linear_onset(kf, "DOB", c, m, b, T),
-                    "cl_onset_n_per_m": linear_onset(kf, "CL", c, m, b, T),
-                }
-            )
-    return rows
+    return [
+        LinearOnset(kf, c, linear_onset(kf, "DOB", c, m, b, T), linear_onset(kf, "CL", c, m, b, T))
+        for kf in kfs
+        for c in gains
+    ]
 
 
 def bandwidth_vs_gain(
@@ -174,7 +233,7 @@ def bandwidth_vs_gain(
     seed: int = 0,
     duration_s: float = 40.0,
     executor: Executor | None = None,
-) -> list[dict]:
+) -> list[GainBandwidth]:
     """DOB transparency bandwidth (Hz) at one wall against the observer gain (batch, ch. 7 hand)."""
     offset, amplitude = reference_for_force(wall, base.hand.stiffness_n_per_m)
     cfgs = [
@@ -190,7 +249,9 @@ def bandwidth_vs_gain(
         for c in gains
     ]
     results = list(executor.map(_summary, cfgs)) if executor else [_summary(c) for c in cfgs]
-    return [{"gain": c, "kf": kf, "wall": wall, **s} for c, s in zip(gains, results, strict=True)]
+    return [
+        GainBandwidth(c, kf, wall, bw, err) for c, (bw, err) in zip(gains, results, strict=True)
+    ]
 
 
 def model_mismatch(
@@ -199,7 +260,7 @@ def model_mismatch(
     walls: tuple[float, ...] = (800.0, 1600.0),
     seed: int = 0,
     executor: Executor | None = None,
-) -> list[dict]:
+) -> list[MismatchCell]:
     """DOB transparency with the exact observer model and one without Coulomb friction (batch).
 
     The thesis (7.3.3.1) blames the high-gain DOB's narrower band on modelling errors: friction
@@ -211,12 +272,13 @@ def model_mismatch(
         "exact": None,
         "no Coulomb": m.__class__(m.mass_kg, m.viscous_n_s_per_m, 0.0, m.axis),
     }
-    cells, cfgs = [], []
+    cells: list[tuple[float, float, str]] = []
+    cfgs = []
     for wall in walls:
         offset, amplitude = reference_for_force(wall, base.hand.stiffness_n_per_m)
         for kf in kfs:
             for name, model in models.items():
-                cells.append({"wall": wall, "kf": kf, "observer_model": name})
+                cells.append((wall, kf, name))
                 cfgs.append(
                     base.replace(
                         law=law_for("DOB", kf, base.law.max_force_n),
@@ -228,12 +290,13 @@ def model_mismatch(
                     )
                 )
     results = list(executor.map(_summary, cfgs)) if executor else [_summary(c) for c in cfgs]
-    return [{**c, **r} for c, r in zip(cells, results, strict=True)]
+    return [MismatchCell(*c, *r) for c, r in zip(cells, results, strict=True)]
 
 
-def _summary(cfg: SessionConfig) -> dict[str, Any]:
+def _summary(cfg: SessionConfig) -> tuple[float | None, float | None]:
+    """(bandwidth Hz, impedance error %) of one batch session."""
     s = run_session(cfg).summary()
-    return {"bandwidth_hz": s["bandwidth_hz"], "impedance_error_pct": s["impedance_error_pct"]}
+    return s["bandwidth_hz"], s["impedance_error_pct"]
 
 
 def traces(base: SessionConfig, stiffness: float, kf: float = 100.0) -> dict[str, SessionResult]:
@@ -245,60 +308,13 @@ def traces(base: SessionConfig, stiffness: float, kf: float = 100.0) -> dict[str
     }
 
 
-def plot_grid(points: list[KickPoint], path: Path) -> None:
-    """Residual RMS against wall stiffness, one line per (c, Coulomb)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for c, fc in sorted({(p.gain, p.coulomb_n) for p in points}):
-        row = sorted(
-            (p for p in points if p.gain == c and p.coulomb_n == fc),
-            key=lambda p: p.stiffness_n_per_m,
-        )
-        ax.semilogy(
-            [p.stiffness_n_per_m for p in row],
-            [max(p.residual_rms_m, 1e-9) * 1e6 for p in row],
-            marker="o",
-            label=f"c = {c:g} N s/m, Coulomb {fc:g} N",
-        )
-    ax.axhline(VIBRATION_RMS_M * 1e6, color="k", ls=":", lw=0.8, label="vibration threshold")
-    ax.set_xlabel("wall stiffness (N/m)")
-    ax.set_ylabel("residual motion 2-3 s after the kick (um RMS)")
-    ax.set_title("DOB Kf = 100 on the slide: what stops the vibration")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def plot_traces(runs: dict[str, SessionResult], stiffness: float, path: Path) -> None:
-    """Depth and command around the kick, with and without Coulomb friction."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
-    for name, r in runs.items():
-        ax1.plot(r.t, r.x_true * 1e3, lw=0.8, label=name)
-        ax2.plot(r.t, r.effort, lw=0.6, label=name)
-    ax1.set_ylabel("position (mm)")
-    ax2.set_ylabel("applied effort (N)")
-    ax2.set_xlabel("time (s)")
-    ax1.set_title(f"DOB Kf = 100, c = 2 N s/m, {stiffness:g} N/m wall: the kick at 1.5 s")
-    ax1.legend(fontsize=8)
-    for ax in (ax1, ax2):
-        ax.grid(True, alpha=0.3)
-    ax2.set_xlim(1.3, 2.5)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def as_dicts(points: list[KickPoint]) -> list[dict]:
-    """JSON-ready rows."""
-    return [{**asdict(p), "vibrates": p.vibrates} for p in points]
+def study(base: SessionConfig, executor: Executor | None = None) -> DobStudy:
+    """The whole mechanism study (batch; ``executor``: a shared process pool)."""
+    kick = kick_grid(base, executor=executor)
+    return DobStudy(
+        kick,
+        [FirstVibrating(c, fc, first_vibrating(kick, c, fc)) for c, fc in KNOBS],
+        linear_onsets(base, LINEAR_GAINS, LINEAR_KFS),
+        bandwidth_vs_gain(base, GAINS_FOR_BANDWIDTH, executor=executor),
+        model_mismatch(base, executor=executor),
+    )

@@ -24,7 +24,7 @@ import threading
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor, as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -32,18 +32,19 @@ import yaml
 
 from haptic_dob.launcher import add_recorder
 from haptic_dob.runtime.params import load_node_params
+from haptic_sim.experiments.records import Cell
 
 COMPLETE = "complete"
 
 
 @dataclass(frozen=True)
 class GraphRun:
-    """One recorded lockstep session: a name, its node parameters and a wall-clock budget."""
+    """One recorded lockstep session: a name, its node parameters and the cell it measures."""
 
     name: str
     params: dict[str, dict[str, Any]]  # node name or "/**" -> dotted parameter values
-    label: str = ""
-    meta: dict[str, Any] = field(default_factory=dict)
+    cell: Cell
+    label: str = ""  # for progress lines
 
     @property
     def duration_s(self) -> float:
@@ -51,7 +52,9 @@ class GraphRun:
         return float(self.params["device_node"]["duration_s"])
 
 
-def session_params(base_config: Path, overrides: dict[str, dict[str, Any]]) -> dict:
+def session_params(
+    base_config: Path, overrides: dict[str, dict[str, Any]]
+) -> dict[str, dict[str, Any]]:
     """The base config's node sections with ``overrides`` laid over them."""
     params = load_node_params(base_config)
     for node, values in overrides.items():
@@ -91,7 +94,7 @@ def _params_yaml(run: GraphRun, bag: Path) -> str:
     params = {k: dict(v) for k, v in run.params.items()}
     add_recorder(params, str(bag), "mcap")
     doc = {"/**" if k == "/**" else f"/**/{k}": {"ros__parameters": v} for k, v in params.items()}
-    return yaml.safe_dump(doc, sort_keys=False)
+    return str(yaml.safe_dump(doc, sort_keys=False))
 
 
 class Stopper:
@@ -99,16 +102,18 @@ class Stopper:
 
     def __init__(self) -> None:
         self.stopping = threading.Event()
-        self._live: set[subprocess.Popen] = set()
+        self._live: set[subprocess.Popen[bytes]] = set()
         self._lock = threading.Lock()
 
-    def add(self, proc: subprocess.Popen) -> None:
+    def add(self, proc: subprocess.Popen[bytes]) -> None:
+        """Track a launch (stopped at once if a stop was asked for already)."""
         with self._lock:
             self._live.add(proc)
         if self.stopping.is_set():
             proc.send_signal(signal.SIGINT)
 
-    def discard(self, proc: subprocess.Popen) -> None:
+    def discard(self, proc: subprocess.Popen[bytes]) -> None:
+        """Forget a launch that ended."""
         with self._lock:
             self._live.discard(proc)
 

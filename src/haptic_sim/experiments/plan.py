@@ -5,6 +5,7 @@ Chapter 7 (transparency): OL, CL with Kf = 2, DOB with Kf = 1 and Kf = 25 on wal
 controller meets the same hand). The hand's push and swing follow the wall
 (``reference_for_force``). OL and CL runs leave the observer out (they do not use it) and the
 controller subscribes only to its own mode's input; the recorder records what the analysis reads.
+The quick variant (the demo) runs OL, CL Kf = 2 and DOB Kf = 1 at 800 N/m for 20 s.
 
 Chapter 6 (vibration onset, through the graph): the push-and-hold protocol of ``haptic-stability``
 (Coulomb friction off, a light 20 N/m grip, a 0.5 N x 5 ms pulse), for OL, CL with Kf = 2 and DOB
@@ -17,12 +18,17 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from haptic_sim.experiments import thesis
 from haptic_sim.experiments.graph_runs import GraphRun, session_params
+from haptic_sim.experiments.records import Cell, label
 from haptic_sim.hand import reference_for_force
 from haptic_sim.stability import StabilityProtocol
 
 CH7_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0), ("DOB", 25.0)]
-CH7_WALLS: list[float] = [80.0, 800.0, 1600.0, 2400.0]
+CH7_WALLS: list[float] = list(thesis.WALLS)
+QUICK_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0)]
+QUICK_WALLS: list[float] = [800.0]
+QUICK_DURATION_S = 20.0
 CH6_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 100.0)]
 #: the thesis's walls (800-3200 N/m) and points around the OL and CL bounds (2544, 848 N/m)
 CH6_WALLS: dict[str, list[float]] = {
@@ -32,44 +38,26 @@ CH6_WALLS: dict[str, list[float]] = {
 }
 RECORDED = ["ee_pose", "ee_twist", "wrench_measured", "/parameter_events"]
 
-#: thesis Table 7.1 (bandwidth, Hz) and 7.2 (impedance error, %), walls 80, 800, 1600, 2400 N/m
-THESIS_BANDWIDTH: dict[tuple[str, float], list[float]] = {
-    ("OL", 0.0): [1.3, 3.8, 5.3, 0.6],
-    ("CL", 2.0): [1.7, 5.5, 6.6, 4.5],
-    ("DOB", 1.0): [1.6, 5.1, 6.0, 5.3],
-    ("DOB", 25.0): [1.8, 2.9, 3.9, 3.4],
-}
-THESIS_ERROR: dict[tuple[str, float], list[float]] = {
-    ("OL", 0.0): [26.8, 30.5, 27.0, 29.0],
-    ("CL", 2.0): [25.4, 30.4, 22.8, 16.5],
-    ("DOB", 1.0): [23.9, 34.0, 30.9, 26.6],
-    ("DOB", 25.0): [40.3, 32.0, 26.0, 22.7],
-}
-#: thesis chapter 6: the lowest wall that vibrated (N/m)
-THESIS_ONSET: dict[str, float] = {"OL": 2400.0, "CL": 800.0, "DOB": 3200.0}
-
-
-def label(mode: str, kf: float) -> str:
-    """``OL``, ``CL Kf=2``..."""
-    return mode if mode == "OL" else f"{mode} Kf={kf:g}"
-
 
 def _loop_nodes(mode: str) -> list[str]:
     nodes = ["environment_node", "controller_node"]
     return [*nodes, "observer_node"] if mode == "DOB" else nodes
 
 
-def _base(base_config: Path, mode: str, kf: float, extra: dict[str, dict[str, Any]]) -> dict:
+def _run(base_config: Path, cell: Cell, extra: dict[str, dict[str, Any]]) -> GraphRun:
+    """The graph run of one cell: the base config, the controller, ``extra`` over them."""
     overrides = {
-        "controller_node": {"mode": mode, "kf": kf, "warm_inputs": False},
-        "device_node": {"wait_for": _loop_nodes(mode), **extra.pop("device_node", {})},
+        "controller_node": {"mode": cell.mode, "kf": cell.kf, "warm_inputs": False},
+        "device_node": {"wait_for": _loop_nodes(cell.mode), **extra.pop("device_node", {})},
         "recorder_node": {"topics": RECORDED},
         **extra,
     }
     params = session_params(base_config, overrides)
-    if mode != "DOB":
+    if cell.mode != "DOB":
         params.pop("observer_node", None)
-    return params
+    name = f"{cell.part}_{cell.mode}_kf{cell.kf:g}_k{cell.wall:g}".replace(".", "p")
+    text = f"{cell.part} {label(cell.mode, cell.kf)}, {cell.wall:g} N/m"
+    return GraphRun(name, params, cell, text)
 
 
 def chapter7_runs(
@@ -94,16 +82,15 @@ def chapter7_runs(
                 },
                 "environment_node": {"stiffness_n_per_m": wall},
             }
-            name = f"ch7_{mode}_kf{kf:g}_k{wall:g}".replace(".", "p")
-            runs.append(
-                GraphRun(
-                    name,
-                    _base(base_config, mode, kf, extra),
-                    f"ch7 {label(mode, kf)}, {wall:g} N/m",
-                    {"part": "ch7", "mode": mode, "kf": kf, "wall": wall},
-                )
-            )
+            runs.append(_run(base_config, Cell("ch7", mode, kf, wall), extra))
     return runs
+
+
+def chapter7_plan(base_config: Path, seed: int, quick: bool) -> list[GraphRun]:
+    """Chapter 7's runs: every cell, or the quick variant's."""
+    if quick:
+        return chapter7_runs(base_config, seed, QUICK_DURATION_S, QUICK_CONTROLLERS, QUICK_WALLS)
+    return chapter7_runs(base_config, seed)
 
 
 def chapter6_runs(
@@ -133,13 +120,10 @@ def chapter6_runs(
                 },
                 "environment_node": {"stiffness_n_per_m": wall},
             }
-            name = f"ch6_{mode}_kf{kf:g}_k{wall:g}".replace(".", "p")
-            runs.append(
-                GraphRun(
-                    name,
-                    _base(base_config, mode, kf, extra),
-                    f"ch6 {label(mode, kf)}, {wall:g} N/m",
-                    {"part": "ch6", "mode": mode, "kf": kf, "wall": wall},
-                )
-            )
+            runs.append(_run(base_config, Cell("ch6", mode, kf, wall), extra))
     return runs
+
+
+def chapter6_plan(base_config: Path, _seed: int, _quick: bool) -> list[GraphRun]:
+    """Chapter 6's runs (the hand holds still: no seed; no quick variant)."""
+    return chapter6_runs(base_config)

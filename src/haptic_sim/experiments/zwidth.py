@@ -2,17 +2,16 @@
 
 Each point is a ``haptic_sim.stability`` sweep (the push-and-hold protocol of the README) run
 coarse-to-fine: a geometric grid locates the first stiffness that vibrates, a second, linear grid
-between its neighbours gives the onset to a few percent. A Z-width plot (Colgate & Brown 1994)
-shows, per controller, the largest stiffness rendered without vibration against the wall
-damping B, beside the passivity bound ``K T / 2 + |B| < b / (1 + Kf)``.
+between its neighbours gives the onset to a few percent. The Z-width (Colgate & Brown 1994) is,
+per controller, the largest stiffness rendered without vibration against the wall damping B,
+beside the passivity bound ``K T / 2 + |B| < b / (1 + Kf)`` (figures in ``figures``).
 """
 
 from __future__ import annotations
 
-import math
+from collections.abc import Callable
 from concurrent.futures import Executor
-from dataclasses import asdict, dataclass
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -22,6 +21,11 @@ from haptic_sim.session import SessionConfig
 from haptic_sim.stability import StabilityProtocol, law_for, onset, sweep
 
 K_MIN, K_MAX = 5.0, 20000.0
+#: the onset against Kf (B = 0): CL and DOB at these Kf, and OL
+MAP_KFS = [0.5, 1.0, 2.0, 5.0, 10.0, 25.0, 100.0]
+#: the Z-width: these controllers against these wall dampings (N s/m)
+ZWIDTH_CONTROLLERS = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0)]
+ZWIDTH_DAMPINGS = [0.0, 0.25, 0.5, 1.0]
 
 
 @dataclass(frozen=True)
@@ -36,9 +40,12 @@ class MapPoint:
     below_range: bool  # vibrated already at K_MIN
     bound_n_per_m: float
 
-    def as_dict(self) -> dict:
-        """JSON-ready."""
-        return asdict(self)
+
+@dataclass(frozen=True)
+class StabilityMap:
+    """The map part's result: the onset against Kf (B = 0), then the Z-width's other dampings."""
+
+    points: list[MapPoint]
 
 
 def passivity_bound(b: float, T: float, kf: float, damping: float) -> float:
@@ -74,7 +81,7 @@ def stability_map(
     base: SessionConfig | None = None,
     observer_gain: float | None = None,
     executor: Executor | None = None,
-    progress=None,
+    progress: Callable[[MapPoint], None] | None = None,
 ) -> list[MapPoint]:
     """Onsets for every (controller, Kf) and wall damping (``executor``: a shared process pool)."""
     base = base or SessionConfig()
@@ -108,73 +115,9 @@ def stability_map(
     return out
 
 
-def plot_onset_vs_kf(points: list[MapPoint], path: Path, b: float, T: float) -> None:
-    """Onset stiffness against Kf per controller at B = 0, with the passivity bound."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    kfs = np.geomspace(0.1, 200, 200)
-    ax.loglog(kfs, 2 * b / (T * (1 + kfs)), "k--", label="bound 2b/(T(1+Kf))")
-    for mode, marker in (("CL", "s"), ("DOB", "o")):
-        pts = sorted(
-            (p for p in points if p.controller == mode and p.damping_n_s_per_m == 0.0),
-            key=lambda p: p.kf,
-        )
-        if not pts:
-            continue
-        x = [p.kf for p in pts]
-        y = [p.onset_n_per_m if p.onset_n_per_m is not None else K_MAX for p in pts]
-        ax.loglog(
-            x,
-            y,
-            marker=marker,
-            label=f"{mode} (c = {pts[0].observer_gain:g} N s/m)" if mode == "DOB" else mode,
-        )
-        for p, yy in zip(pts, y, strict=True):
-            if p.below_range:
-                ax.annotate("vibrates at any K", (p.kf, yy), fontsize=7, rotation=45)
-    ol = [p for p in points if p.controller == "OL" and p.damping_n_s_per_m == 0.0]
-    if ol and ol[0].onset_n_per_m:
-        ax.axhline(ol[0].onset_n_per_m, color="grey", lw=0.8, label="OL onset")
-    ax.set_xlabel("force gain Kf")
-    ax.set_ylabel("vibration-onset stiffness (N/m)")
-    ax.set_ylim(K_MIN, K_MAX * 1.2)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title("Slide: onset against force gain (push-and-hold protocol)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def plot_zwidth(points: list[MapPoint], path: Path, b: float, T: float) -> None:
-    """Z-width: largest vibration-free stiffness against wall damping, per controller."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    groups: dict[tuple[str, float], list[MapPoint]] = {}
-    for p in points:
-        groups.setdefault((p.controller, p.kf), []).append(p)
-    for (mode, kf), pts in sorted(groups.items()):
-        pts.sort(key=lambda p: p.damping_n_s_per_m)
-        d = [p.damping_n_s_per_m for p in pts]
-        k = [p.onset_n_per_m if p.onset_n_per_m is not None else math.nan for p in pts]
-        label = mode if mode == "OL" else f"{mode} Kf={kf:g}"
-        (line,) = ax.plot(d, k, marker="o", label=label)
-        bounds = [p.bound_n_per_m if p.bound_n_per_m > 0 else math.nan for p in pts]
-        ax.plot(d, bounds, ls=":", color=line.get_color())
-    ax.set_yscale("log")
-    ax.set_xlabel("wall damping B (N s/m)")
-    ax.set_ylabel("largest stiffness without vibration (N/m)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8, title="measured (solid), passivity bound (dotted)", title_fontsize=7)
-    ax.set_title("Z-width of the slide (batch simulation)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+def map_study(base: SessionConfig, executor: Executor | None = None) -> StabilityMap:
+    """The onset against Kf for OL, CL and DOB (B = 0) and the Z-width's rows (B > 0)."""
+    controllers = [("OL", 0.0)] + [(m, kf) for m in ("CL", "DOB") for kf in MAP_KFS]
+    points = stability_map(controllers, [0.0], base, executor=executor)
+    damped = [d for d in ZWIDTH_DAMPINGS if d != 0.0]
+    return StabilityMap(points + stability_map(ZWIDTH_CONTROLLERS, damped, base, executor=executor))

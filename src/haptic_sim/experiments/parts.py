@@ -1,0 +1,239 @@
+"""The one table of the reproduction's experiments: ``EXPERIMENTS``, one entry per part.
+
+An entry says how its part runs (through the node graph or in batch), the type of its result, and
+its section of the report: heading, introduction, tables and text, figures, notes, acceptance
+checks, the paragraphs it adds to "where the simulation differs", and its lines in the terminal.
+``haptic-experiment`` runs the parts from it and the report renders them from it, in its order;
+``save_results`` and ``load_results`` write and read ``results.json`` through its result types.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from concurrent.futures import Executor
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Generic, TypeVar
+
+from haptic_sim.experiments import (
+    discussion,
+    dob,
+    figures,
+    phantom,
+    plan,
+    results,
+    tables,
+    zwidth,
+)
+from haptic_sim.experiments.graph_runs import GraphRun
+from haptic_sim.experiments.jsonio import from_json, to_json
+from haptic_sim.experiments.records import (
+    Ch6Result,
+    Ch7Result,
+    Check,
+    ExperimentResults,
+    RunAnalysis,
+)
+from haptic_sim.session import SessionConfig
+
+R = TypeVar("R")
+
+
+@dataclass(frozen=True)
+class GraphJob(Generic[R]):
+    """A part run through the node graph: its runs, and its result from their analyses."""
+
+    runs: Callable[[Path, int, bool], list[GraphRun]]  # (base config file, seed, quick)
+    collect: Callable[[list[RunAnalysis], SessionConfig], R]  # the runs' analyses, in order
+
+
+@dataclass(frozen=True)
+class BatchJob(Generic[R]):
+    """A part run in batch simulation (its result cached in ``batch/<part>.json``)."""
+
+    compute: Callable[[SessionConfig, Executor, Path], R]  # (base, process pool, figures dir)
+    done: Callable[[R], str]  # the progress line once it is done
+
+
+@dataclass(frozen=True)
+class Figure(Generic[R]):
+    """``figures/<file>`` of a part's section.
+
+    ``plot`` draws it from the result when the report is written; ``simulate`` draws it from a
+    simulation of its own while the part runs (when missing); with neither, the part's run
+    draws it.
+    """
+
+    file: str
+    alt: str
+    plot: Callable[[R, Path, SessionConfig], None] | None = None
+    simulate: Callable[[SessionConfig, Path], None] | None = None
+
+
+def _nothing(_result: object) -> list[str]:
+    return []
+
+
+def _no_checks(_result: object) -> list[Check]:
+    return []
+
+
+@dataclass(frozen=True)
+class Experiment(Generic[R]):
+    """One part of the reproduction: how it runs and its section of the report."""
+
+    part: str  # its name in --parts and results.json
+    result_type: type[R]
+    job: GraphJob[R] | BatchJob[R]
+    heading: str
+    body: Callable[[R, SessionConfig], list[str]]  # tables and text before the figures
+    figures: tuple[Figure[R], ...]
+    intro: str = ""
+    quick: bool = False  # run by --quick
+    notes: Callable[[R], list[str]] = _nothing  # after the figures
+    checks: Callable[[R], list[Check]] = _no_checks
+    differences: Callable[[R], list[str]] = _nothing  # bullet paragraphs
+    console: Callable[[R], list[str]] = _nothing
+
+    def result_in(self, res: ExperimentResults) -> R | None:
+        """This part's result in ``res``; None if it was not run."""
+        r = res.results.get(self.part)
+        return r if isinstance(r, self.result_type) else None
+
+
+def _b_rate(base: SessionConfig) -> tuple[float, float]:
+    """The slide's viscous friction (N s/m) and the loop rate (Hz): the bound's inputs."""
+    return base.model.viscous_n_s_per_m, base.loop.rate_hz
+
+
+def _kick_traces(base: SessionConfig, path: Path) -> None:
+    """The stick-or-chatter traces: simulated and drawn while the dob part runs."""
+    wall = dob.TRACES_WALL
+    figures.plot_kick_traces(dob.traces(base, wall), wall, path)
+
+
+CH7: Experiment[Ch7Result] = Experiment(
+    part="ch7",
+    result_type=Ch7Result,
+    job=GraphJob(plan.chapter7_plan, lambda rows, _base: results.ch7_result(rows)),
+    heading="Chapter 7: transparency",
+    body=lambda r, _base: [tables.ch7_tables(r.rows)],
+    figures=(
+        Figure(
+            "ch7_transparency.png",
+            "chapter 7",
+            lambda r, path, _base: figures.plot_ch7(r.rows, path),
+        ),
+    ),
+    quick=True,
+    notes=lambda r: [discussion.ch7_notes(r.rows)],
+    checks=lambda r: r.checks,
+    differences=lambda r: discussion.ch7_differences(r.rows),
+    console=lambda r: tables.ch7_console(r.rows),
+)
+CH6: Experiment[Ch6Result] = Experiment(
+    part="ch6",
+    result_type=Ch6Result,
+    job=GraphJob(plan.chapter6_plan, results.ch6_result),
+    heading="Chapter 6: vibration onset through the node graph",
+    intro="The push-and-hold protocol of `haptic-stability` (README) run as node-graph "
+    "sessions; the onset is the interpolated zero crossing of the pulse response's "
+    "growth rate along the walls.",
+    body=lambda r, base: [tables.ch6_table(r.onsets, *_b_rate(base))],
+    figures=(
+        Figure(
+            "ch6_onsets.png",
+            "chapter 6",
+            lambda r, path, base: figures.plot_ch6(r.onsets, path, *_b_rate(base)),
+        ),
+    ),
+    checks=lambda r: r.checks,
+    differences=lambda _r: [
+        discussion.ONSETS_FROM_A_PROTOCOL,
+        discussion.OBSERVER_GAIN_NOT_IN_THESIS,
+    ],
+    console=lambda r: tables.ch6_console(r.onsets),
+)
+MAP: Experiment[zwidth.StabilityMap] = Experiment(
+    part="map",
+    result_type=zwidth.StabilityMap,
+    job=BatchJob(
+        lambda base, pool, _figs: zwidth.map_study(base, pool),
+        lambda r: f"stability map: {len(r.points)} onsets",
+    ),
+    heading="Stability map (batch)",
+    intro="The same protocol swept coarse-to-fine in batch simulation for each Kf, and for "
+    "three controllers against the wall damping (Z-width).",
+    body=lambda r, _base: [tables.map_table(r.points)],
+    figures=(
+        Figure(
+            "onset_vs_kf.png",
+            "onset against Kf",
+            lambda r, path, base: figures.plot_onset_vs_kf(
+                r.points, path, base.model.viscous_n_s_per_m, 1.0 / base.loop.rate_hz
+            ),
+        ),
+        Figure("zwidth.png", "Z-width", lambda r, path, _base: figures.plot_zwidth(r.points, path)),
+    ),
+)
+DOB: Experiment[dob.DobStudy] = Experiment(
+    part="dob",
+    result_type=dob.DobStudy,
+    job=BatchJob(
+        lambda base, pool, _figs: dob.study(base, pool),
+        lambda _r: "DOB mechanism study: done",
+    ),
+    heading="The DOB question: quiet at Kf = 100 up to 3200 N/m",
+    intro="The hand as on the bench (0.1 kg, 300 N/m grip, 5 N s/m) holds the handle "
+    "against the wall with 1.5 N and is kicked with 3 N for 20 ms; the residual "
+    "motion 2-3 s later says whether the wall keeps vibrating.",
+    body=lambda r, _base: [tables.dob_tables(r), discussion.dob_discussion(r)],
+    figures=(
+        Figure(
+            "dob_kick_grid.png",
+            "kick grid",
+            lambda r, path, _base: figures.plot_kick_grid(r.kick, path),
+        ),
+        Figure("dob_kick_traces.png", "stick or chatter", simulate=_kick_traces),
+    ),
+    differences=lambda _r: [discussion.OBSERVER_GAIN_NOT_IN_THESIS],
+)
+PHANTOM: Experiment[phantom.PhantomResult] = Experiment(
+    part="phantom",
+    result_type=phantom.PhantomResult,
+    job=BatchJob(
+        lambda _base, _pool, figs: phantom.reproduce(figs),
+        lambda _r: "PHANToM section 5.2: done",
+    ),
+    heading="Thesis section 5.2: the PHANToM 1.5 (batch)",
+    body=lambda r, _base: [discussion.phantom_text(r)],
+    figures=(Figure("thesis_5_2_1.png", "5.2.1"), Figure("thesis_5_2_2.png", "5.2.2")),
+)
+#: the parts in the report's order
+EXPERIMENTS: tuple[Experiment[Any], ...] = (CH7, CH6, MAP, DOB, PHANTOM)
+PARTS: tuple[str, ...] = tuple(e.part for e in EXPERIMENTS)
+QUICK_PARTS: list[str] = [e.part for e in EXPERIMENTS if e.quick]
+
+
+def present(res: ExperimentResults) -> list[tuple[Experiment[Any], Any]]:
+    """The parts run in ``res`` with their results, in the table's order."""
+    found = [(e, e.result_in(res)) for e in EXPERIMENTS]
+    return [(e, r) for e, r in found if r is not None]
+
+
+def save_results(path: Path, res: ExperimentResults) -> None:
+    """Write ``results.json`` (indented JSON; the parts in the table's order)."""
+    ordered = replace(res, results={e.part: r for e, r in present(res)})
+    path.write_text(json.dumps(to_json(ordered), indent=1) + "\n", encoding="utf-8")
+
+
+def load_results(path: Path) -> ExperimentResults:
+    """Read ``results.json`` back into typed results; ``ValueError`` if it is not one."""
+    res = from_json(ExperimentResults, json.loads(path.read_text(encoding="utf-8")))
+    types = {e.part: e.result_type for e in EXPERIMENTS}
+    unknown = set(res.results) - set(types)
+    if unknown:
+        raise ValueError(f"{path}: unknown part(s) {', '.join(sorted(unknown))}")
+    typed = {p: from_json(types[p], v) for p, v in res.results.items()}
+    return replace(res, results=typed)

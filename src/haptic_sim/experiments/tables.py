@@ -1,0 +1,240 @@
+"""The report's Markdown tables, and the terminal's summary lines, from the typed results."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from haptic_sim.experiments import thesis
+from haptic_sim.experiments.dob import VIBRATION_RMS_M, WALLS, DobStudy, KickPoint
+from haptic_sim.experiments.plan import CH7_CONTROLLERS
+from haptic_sim.experiments.records import ExperimentResults, GraphOnset, RunAnalysis, label
+from haptic_sim.experiments.results import bound, ch7_grid
+from haptic_sim.experiments.zwidth import MapPoint
+from haptic_sim.session import SessionConfig
+
+
+def fmt(v: float | None, spec: str = ".2f", none: str = "–") -> str:
+    """``v`` formatted with ``spec``; ``none`` when it is None or not finite."""
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return none
+    return format(v, spec)
+
+
+# --- chapters 7 and 6 through the graph ---------------------------------------------------------
+#: the chapter-7 tables: title, the row's value, its column in ``thesis.cell``, number format
+CH7_TABLES: tuple[tuple[str, Callable[[RunAnalysis], float | None], int, str], ...] = (
+    (
+        "Transparency bandwidth (Hz): simulation / thesis Table 7.1",
+        lambda r: r.bandwidth_hz,
+        0,
+        ".2f",
+    ),
+    (
+        "Average impedance error in the band (%): simulation / thesis Table 7.2",
+        lambda r: r.impedance_error_pct,
+        1,
+        ".1f",
+    ),
+)
+
+
+def ch7_tables(rows: list[RunAnalysis]) -> str:
+    """Tables 7.1 and 7.2 with the simulation beside the thesis (``sim / thesis``)."""
+    ctls, walls, cells = ch7_grid(rows)
+    out = []
+    for title, value, idx, spec in CH7_TABLES:
+        out.append(f"**{title}**\n")
+        out.append("| controller | " + " | ".join(f"{w:g} N/m" for w in walls) + " |")
+        out.append("|---|" + "---|" * len(walls))
+        for mode, kf in ctls:
+            cols = []
+            for w in walls:
+                r = cells.get((mode, kf, w))
+                ref = thesis.cell(mode, kf, w)[idx]
+                cols.append(f"{fmt(None if r is None else value(r), spec)} / {fmt(ref, 'g')}")
+            out.append(f"| {label(mode, kf)} | " + " | ".join(cols) + " |")
+        out.append("")
+    return "\n".join(out)
+
+
+def ch6_table(onsets: list[GraphOnset], b: float, rate_hz: float) -> str:
+    """The onset table (graph) and the per-wall growth rates."""
+    lines = [
+        "| controller | onset, graph (N/m) | bound 2b/(T(1+Kf)) (N/m) | thesis: first wall "
+        "that vibrated (N/m) |",
+        "|---|---|---|---|",
+    ]
+    for e in onsets:
+        k_on = e.onset_n_per_m
+        bnd = bound(e.mode, e.kf, b, rate_hz)
+        shown = fmt(k_on, ".0f", "none up to the last wall")
+        if e.first_point_vibrates and k_on is not None:
+            shown = f"<= {k_on:.0f} (the lowest wall vibrates)"
+        ref = thesis.ONSET_N_PER_M.get(e.mode)
+        lines.append(f"| {e.controller} | {shown} | {bnd:.0f} | {fmt(ref, 'g')} |")
+    lines += [
+        "",
+        "Pulse-response growth rate per wall (1/s; > 0 grows, `vib` = sustained before the pulse):",
+        "",
+    ]
+    for e in onsets:
+        pts = ", ".join(f"{p.wall:g}: {fmt(p.growth_per_s, '+.2f', 'vib')}" for p in e.points)
+        lines.append(f"- {e.controller}: {pts}")
+    return "\n".join(lines) + "\n"
+
+
+def ch7_console(rows: list[RunAnalysis]) -> list[str]:
+    """The chapter-7 cells for the terminal, by wall, beside the thesis's."""
+
+    def order(r: RunAnalysis) -> tuple[float, int]:
+        c = (r.mode, r.kf)
+        return r.wall, CH7_CONTROLLERS.index(c) if c in CH7_CONTROLLERS else 9
+
+    out = [f"{'controller':<12}{'wall':>9}{'bandwidth':>11}{'imp. error':>12}   thesis"]
+    for r in sorted(rows, key=order):
+        bw, err = thesis.cell(r.mode, r.kf, r.wall)
+        out.append(
+            f"{r.controller_label:<12}{r.wall:>5g} N/m{fmt(r.bandwidth_hz):>8} Hz"
+            f"{fmt(r.impedance_error_pct, '.1f'):>10} %   {fmt(bw, 'g')} Hz, {fmt(err, 'g')} %"
+        )
+    return out
+
+
+def ch6_console(onsets: list[GraphOnset]) -> list[str]:
+    """The chapter-6 onsets for the terminal."""
+    return [f"onset {e.controller}: {fmt(e.onset_n_per_m, '.0f')} N/m" for e in onsets]
+
+
+# --- the stability map --------------------------------------------------------------------------
+def map_table(points: list[MapPoint]) -> str:
+    """Onset against Kf (B = 0) and the Z-width rows."""
+    lines = [
+        "| controller | Kf | wall damping (N s/m) | onset (N/m) | passivity bound (N/m) |",
+        "|---|---|---|---|---|",
+    ]
+    for p in sorted(points, key=lambda p: (p.controller, p.damping_n_s_per_m, p.kf)):
+        shown = (
+            "vibrates at any K"
+            if p.below_range
+            else fmt(p.onset_n_per_m, ".0f", "none up to 20000")
+        )
+        lines.append(
+            f"| {p.controller} | {p.kf:g} | {p.damping_n_s_per_m:g} | {shown} | "
+            f"{p.bound_n_per_m:.0f} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+# --- the DOB question ---------------------------------------------------------------------------
+def _kick_cell(p: KickPoint) -> str:
+    rms = f"{p.residual_rms_m * 1e6:.1f}"
+    return f"{rms} @ {p.frequency_hz:.0f} Hz" if p.vibrates else rms
+
+
+def dob_tables(d: DobStudy) -> str:
+    """Tables of the mechanism study."""
+    lines = [
+        "**Linear loop model** (no saturation, no Coulomb friction; hand a pure force "
+        "source): lowest unstable wall (N/m); 0 = unstable at any stiffness.",
+        "",
+        "| Kf | c (N s/m) | DOB | CL, ideal sensor |",
+        "|---|---|---|---|",
+    ]
+    for r in d.linear:
+        lines.append(
+            f"| {r.kf:g} | {r.gain:g} | {fmt(r.dob_onset_n_per_m, '.0f', 'stable')}"
+            f" | {fmt(r.cl_onset_n_per_m, '.0f', 'stable')} |"
+        )
+    lines += [
+        "",
+        f"**Kick grid** (DOB Kf = 100; residual motion 2-3 s after the kick, um RMS; "
+        f"vibrating above {VIBRATION_RMS_M * 1e6:g} um):",
+        "",
+        "| c (N s/m) | Coulomb (N) | "
+        + " | ".join(f"{w:g}" for w in WALLS)
+        + " | first wall that vibrates |",
+        "|---|---|" + "---|" * (len(WALLS) + 1),
+    ]
+    for fv in d.first_vibrating:
+        row = {
+            p.stiffness_n_per_m: p
+            for p in d.kick
+            if p.gain == fv.gain and p.coulomb_n == fv.coulomb_n
+        }
+        cols = [_kick_cell(row[w]) for w in WALLS if w in row]
+        lines.append(
+            f"| {fv.gain:g} | {fv.coulomb_n:g} | "
+            + " | ".join(cols)
+            + f" | {fmt(fv.wall, 'g', 'none')} |"
+        )
+    lines += [
+        "",
+        "**DOB Kf = 1 transparency against the observer gain** (batch, 800 N/m, the "
+        "chapter-7 hand):",
+        "",
+        "| c (N s/m) | bandwidth (Hz) | impedance error (%) |",
+        "|---|---|---|",
+    ]
+    for g in d.bandwidth_vs_gain:
+        lines.append(
+            f"| {g.gain:g} | {fmt(g.bandwidth_hz)} | {fmt(g.impedance_error_pct, '.1f')} |"
+        )
+    if d.model_mismatch:
+        lines += [
+            "",
+            "**DOB with an observer model that leaves Coulomb friction out** (batch, the "
+            "chapter-7 hand; bandwidth Hz / impedance error %):",
+            "",
+            "| wall (N/m) | Kf | exact model | no Coulomb in the model |",
+            "|---|---|---|---|",
+        ]
+        cells = {(c.wall, c.kf, c.observer_model): c for c in d.model_mismatch}
+        for wall, kf in sorted({(c.wall, c.kf) for c in d.model_mismatch}):
+            cols = [
+                f"{fmt(c.bandwidth_hz)} / {fmt(c.impedance_error_pct, '.1f')}"
+                for c in (cells[(wall, kf, "exact")], cells[(wall, kf, "no Coulomb")])
+            ]
+            lines.append(f"| {wall:g} | {kf:g} | " + " | ".join(cols) + " |")
+    return "\n".join(lines) + "\n"
+
+
+# --- configuration ------------------------------------------------------------------------------
+def config_table(res: ExperimentResults, base: SessionConfig) -> str:
+    """The parameters that shape the results."""
+    m, s, h, d, o = base.model, base.sensor, base.hand, base.device, base.observer
+    rows = [
+        (
+            "slide",
+            f"m {m.mass_kg} kg, viscous b {m.viscous_n_s_per_m} N s/m, Coulomb {m.coulomb_n} N",
+        ),
+        ("loop", f"{base.loop.rate_hz:g} Hz, {base.loop.substeps} physics sub-steps, lockstep"),
+        ("actuator", f"saturation {d.max_force_n} N, encoder {d.encoder_resolution_m} m"),
+        (
+            "force sensor",
+            f"bandwidth {s.bandwidth_hz} Hz, noise {s.noise_std_n} N RMS, bias {s.bias_n} N",
+        ),
+        (
+            "observer",
+            f"c = {o.gain} N s/m (m/c = {1e3 * m.mass_kg / o.gain:.0f} ms), output "
+            f"limit {o.output_limit} N, model = the plant",
+        ),
+        ("controller", f"saturation {base.law.max_force_n} N"),
+        (
+            "hand, ch. 7",
+            f"{h.behaviour}: mass {h.mass_kg} kg, grip {h.stiffness_n_per_m} N/m, "
+            f"damping {h.damping_n_s_per_m} N s/m, band {h.band_low_hz}-{h.band_high_hz} Hz, push "
+            f"and swing scaled to the wall; seed {res.seed}",
+        ),
+        (
+            "hand, ch. 6",
+            "push-and-hold: 1 N through a 20 N/m grip, no hand mass or damping, "
+            "Coulomb friction off, 0.5 N x 5 ms pulse at 1.5 s",
+        ),
+    ]
+    head = (
+        f"Base config `{res.config}` (node parameters in `results.json`, `config_params`); "
+        "each run's full parameter file is `runs/<run>/params.yaml`, and its bag records every "
+        "node's parameters.\n\n| | |\n|---|---|\n"
+    )
+    return head + "\n".join(f"| {k} | {v} |" for k, v in rows) + "\n"
