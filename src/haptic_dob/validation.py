@@ -63,7 +63,7 @@ def unit_vector(name: str, value: ArrayLike, size: int = 3) -> NDArray[np.float6
     if norm < 1e-12:
         raise ValueError(f"{name} must be a non-zero vector, got {arr.tolist()}")
     if not np.isfinite(norm):  # finite entries whose squares overflow: scale them first
-        scaled = arr / np.max(np.abs(arr))
+        scaled: NDArray[np.float64] = arr / float(np.max(np.abs(arr)))
         return scaled / float(np.linalg.norm(scaled))
     return arr / norm
 

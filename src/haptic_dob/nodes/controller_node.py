@@ -199,7 +199,8 @@ class ControllerNode(LoopNode):
         """While a cycle is pending: when to name the inputs it still lacks."""
         join = self.join
         if join.pending() and join.newest_ns != self._warned_ns:
-            return self._pending_since + self.params.values["input_warn_s"]
+            warn_s: float = self.params.values["input_warn_s"]
+            return self._pending_since + warn_s
         return None
 
     def on_wakeup(self, now: float) -> None:
