@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -23,6 +25,22 @@ def tool(name: str) -> str:
     path = BIN / name
     assert path.exists(), f"{name} is not installed in {BIN}"
     return str(path)
+
+
+@pytest.fixture
+def context(monkeypatch: pytest.MonkeyPatch) -> Iterator[Any]:
+    """An initialised rclpy context of its own on a random ROS domain (shut down after)."""
+    import rclpy
+    from rclpy.context import Context
+
+    from rosgraph import isolated_env
+
+    env = isolated_env()
+    monkeypatch.setenv("ROS_DOMAIN_ID", env["ROS_DOMAIN_ID"])
+    ctx = Context()
+    rclpy.init(context=ctx, args=[])
+    yield ctx
+    rclpy.try_shutdown(context=ctx)
 
 
 @pytest.fixture(autouse=True)

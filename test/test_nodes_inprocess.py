@@ -17,16 +17,6 @@ from rosgraph import isolated_env
 NODES = [DeviceNode, EnvironmentNode, ObserverNode, ControllerNode]
 
 
-@pytest.fixture
-def context(monkeypatch: pytest.MonkeyPatch):
-    env = isolated_env()
-    monkeypatch.setenv("ROS_DOMAIN_ID", env["ROS_DOMAIN_ID"])
-    ctx = Context()
-    rclpy.init(context=ctx, args=[])
-    yield ctx
-    rclpy.try_shutdown(context=ctx)
-
-
 @pytest.mark.parametrize("cls", NODES, ids=lambda c: c.__name__)
 def test_every_parameter_has_a_description_and_ranges(cls, context) -> None:
     node = cls(context=context)

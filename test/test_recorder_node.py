@@ -10,7 +10,6 @@ from pathlib import Path
 
 import pytest
 import rclpy
-from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
@@ -24,16 +23,6 @@ from haptic_msgs_py.stamps import command_label
 from haptic_msgs_py.topics import EE_POSE, EFFORT_COMMAND, SESSION_TOPICS
 from rosgraph import isolated_env
 from waits import wait_until
-
-
-@pytest.fixture
-def context(monkeypatch: pytest.MonkeyPatch):
-    env = isolated_env()
-    monkeypatch.setenv("ROS_DOMAIN_ID", env["ROS_DOMAIN_ID"])
-    ctx = Context()
-    rclpy.init(context=ctx, args=[])
-    yield ctx
-    rclpy.try_shutdown(context=ctx)
 
 
 def spin(ex: SingleThreadedExecutor) -> Callable[[], None]:
