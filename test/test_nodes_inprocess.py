@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 import rclpy
 from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
 from haptic_dob.nodes.controller_node import ControllerNode
@@ -13,6 +14,7 @@ from haptic_dob.nodes.observer_node import ObserverNode
 from haptic_msgs_py.values import EffortCommand, StampedVector
 from haptic_sim.nodes.device_node import DeviceNode
 from rosgraph import isolated_env
+from waits import wait_until
 
 NODES = [DeviceNode, EnvironmentNode, ObserverNode, ControllerNode]
 
@@ -219,5 +221,41 @@ def test_a_realtime_device_ticks_only_once_its_graph_is_up(monkeypatch, wait_for
             assert dev.waiting_for() == "node absent_node in /"
             assert dev._report()[1] == "waiting for the graph"
     finally:
+        dev.destroy_node()
+        rclpy.try_shutdown(context=ctx)
+
+
+def test_a_realtime_device_publishes_its_stamps_on_clock(monkeypatch) -> None:
+    """In real time too, ``/clock`` carries the samples' stamps (k * T from the run's start), so
+    tools with ``use_sim_time`` share the loop's time base (issue: stamps vs ROS time)."""
+    import time
+
+    from rosgraph_msgs.msg import Clock
+
+    from haptic_msgs_py.ros.qos import CLOCK
+
+    monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
+    ctx = Context()
+    rclpy.init(context=ctx, args=["--ros-args", "-p", "clock_mode:=realtime", "-p", "wait_for:=[]"])
+    dev = DeviceNode(context=ctx)
+    probe = rclpy.create_node("clock_probe", context=ctx)
+    got: list[int] = []
+    probe.create_subscription(
+        Clock, "/clock", lambda m: got.append(m.clock.sec * 10**9 + m.clock.nanosec), CLOCK
+    )
+    ex = SingleThreadedExecutor(context=ctx)
+    ex.add_node(probe)
+    ex.add_node(dev)  # its publisher-matched events
+    try:
+        assert wait_until(lambda: dev._p_clock.wanted, 30, step=lambda: ex.spin_once(0.05))
+        for _ in range(20):
+            dev.on_wakeup(time.monotonic())
+        last = dev.device.k * dev.device.period_ns  # the newest sample's stamp
+        # /clock keeps only its newest message (depth 1): what arrives ends with the newest stamp
+        assert wait_until(lambda: got and got[-1] == last, 30, step=lambda: ex.spin_once(0.05))
+        assert all(t % dev.device.period_ns == 0 for t in got) and got == sorted(set(got))
+    finally:
+        ex.shutdown()
+        probe.destroy_node()
         dev.destroy_node()
         rclpy.try_shutdown(context=ctx)

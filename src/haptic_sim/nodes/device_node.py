@@ -2,8 +2,9 @@
 
 Publishes per sample k (stamp ``k * T``): ``ee_pose``, ``ee_twist``, ``joint_states`` (position,
 velocity, and the effort applied over [k-1, k) after saturation), ``wrench_measured`` (the handle
-force sensor), ``sim/hand_wrench`` (the true hand force, for evaluation) and, in lockstep,
-``/clock``. Takes ``effort_command`` (Float64MultiArray in joint order).
+force sensor), ``sim/hand_wrench`` (the true hand force, for evaluation) and ``/clock`` (the
+stamp as ROS time, in both clock modes; these two only while someone reads them). Takes
+``effort_command`` (Float64MultiArray in joint order).
 
 - lockstep: sample 0 goes out once the nodes in ``wait_for`` are up and matched; sample k+1 only
   after command k (labelled ``effort@<stamp>``, or unlabelled) arrived. If no command comes within
@@ -88,11 +89,9 @@ class DeviceNode(LoopNode):
         self._p_measured = pub(WRENCH_MEASURED, codecs.WRENCH)
         # evaluation topics: sent only while someone listens
         self._p_hand = pub(HAND_WRENCH, codecs.WRENCH, on_demand=True)
-        self._p_clock = (
-            LoopPublisher(self, CLOCK, codecs.CLOCK, qos.CLOCK, on_demand=True)
-            if self.lockstep
-            else None
-        )
+        # the sample's stamp as ROS time, in both clock modes: tools with use_sim_time (ros2 bag
+        # record --use-sim-time, a node's -p use_sim_time:=true) share the loop's time base
+        self._p_clock = LoopPublisher(self, CLOCK, codecs.CLOCK, qos.CLOCK, on_demand=True)
         self._sub = LoopSubscription(
             self, EFFORT_COMMAND, codecs.EFFORT, self.loop.command, qos.LOOP_IN
         )
@@ -144,7 +143,7 @@ class DeviceNode(LoopNode):
             # evaluation-only topics: built only when someone takes them
             if self._p_hand.wanted:
                 self._p_hand.publish(StampedVector(k, s.hand_force))
-            if self._p_clock is not None and self._p_clock.wanted:
+            if self._p_clock.wanted:
                 self._p_clock.publish(Stamp(k))
         finally:
             bus.end()
