@@ -15,6 +15,7 @@ that every tool opens, and says what it recovered.
 
 from __future__ import annotations
 
+import json
 import shutil
 import sqlite3
 import struct
@@ -26,6 +27,7 @@ from typing import Any
 from haptic_dob.bag.errors import BagError
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
+RECOVERED_KEY = "haptic_dob.recovered"  # custom data of a recovered bag: where it came from
 _OP_DATA_END = 0x0F
 _OP_FOOTER = 0x02
 _RECORD_HEAD = 9  # opcode (1 byte) + record length (uint64)
@@ -42,6 +44,15 @@ class Recovery:
     topics: int
     duration_s: float  # from the first to the last recovered message
     dropped_bytes: int  # MCAP: the incomplete tail left out (sqlite3: 0)
+
+    def as_json(self) -> dict[str, Any]:
+        """What the recovered bag's metadata says of its origin (custom data ``RECOVERED_KEY``)."""
+        return {
+            "source": str(self.source),
+            "storage": self.storage,
+            "messages": self.messages,
+            "dropped_bytes": self.dropped_bytes,
+        }
 
     def summary(self) -> str:
         """One line for the user."""
@@ -194,8 +205,10 @@ def recover(bag: str | Path, out: str | Path | None = None) -> Recovery:
                 count += 1
                 first = stamp if first is None else first
                 last = stamp
+            span = (last - first) * 1e-9 if first is not None and last is not None else 0.0
+            got = Recovery(bag, target, storage, count, len(conns), span, dropped)
+            writer.set_custom_data(RECOVERED_KEY, json.dumps(got.as_json()))
             writer.close()
         finally:
             reader.close()
-    span = (last - first) * 1e-9 if first is not None and last is not None else 0.0
-    return Recovery(bag, target, storage, count, len(conns), span, dropped)
+    return got
