@@ -197,6 +197,22 @@ def command(loop: DeviceLoop, effort: float, stamped: bool = True) -> None:
     loop.command(EffortCommand(stamp, (effort,)))
 
 
+def test_what_appears_during_the_settle_time_is_waited_for_too() -> None:
+    """A recorder's node shows before its subscriptions do: after the settle time the graph is
+    checked again, and sample 0 waits for them to match (the loop's topics are volatile)."""
+    loop, port, _log = make_loop(lockstep=True)
+    loop.wakeup(1.0)
+    assert loop.deadline == pytest.approx(1.5) and not port.sent  # settling
+    port.waiting = "the subscribers of /joint_states to match"
+    loop.wakeup(1.5)
+    assert not loop.started and not port.sent and loop.deadline == pytest.approx(1.55)
+    port.waiting = ""
+    loop.wakeup(2.0)
+    assert not port.sent and loop.deadline == pytest.approx(2.5)  # settles again
+    loop.wakeup(2.5)
+    assert loop.started and [s.k for s in port.sent] == [0]
+
+
 def test_sample_0_waits_for_the_graph_and_the_settle_time() -> None:
     loop, port, log = make_loop(lockstep=True)
     port.waiting = "node controller_node in /"

@@ -232,14 +232,17 @@ class DeviceLoop:
             self.check_drained()
             self.deadline = now + GRAPH_POLL_S
             return
-        if not self.started and self.ready_since is None:
-            if not self.graph_ready():
+        if not self.started:
+            settling = self.ready_since is not None
+            if not self.graph_ready():  # again after the settle time: entities that came late
+                self.ready_since = None
                 self.deadline = now + GRAPH_POLL_S
                 return
-            self.ready_since = now
-            if self.lockstep or self.settings.wait_for:
-                self.deadline = now + self.settings.start_delay_s
-                return
+            if not settling:
+                self.ready_since = now
+                if self.lockstep or self.settings.wait_for:
+                    self.deadline = now + self.settings.start_delay_s
+                    return
         if not self.lockstep:
             self.tick(now)
         elif not self.started:

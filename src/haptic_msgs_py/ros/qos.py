@@ -1,9 +1,12 @@
 """QoS profiles of the haptic loop.
 
-Loop publishers are reliable and transient-local and keep the last 2000 samples: a recorder
-(which must not lose a sample) subscribing reliable + transient-local gets every sample even when
-its subscription matched a publisher late after start-up (endpoint matching between processes
-takes a moment) or fell behind, by up to 2000 samples (2 s at 1 kHz).
+Loop publishers are reliable and volatile and keep the last 2000 samples: a reliable reader that
+falls behind (a recorder on a loaded machine) gets every sample repaired from that history, by up
+to 2000 samples (2 s at 1 kHz), and a reader that joins late (``ros2 topic echo``, a plot, RViz)
+sees the live stream at once, not a replay. A reader that must have every sample from the first
+(the recorder) is matched before sample 0: the device waits for the nodes in its ``wait_for``
+(``haptic-launch --record`` adds the recorder) and for every subscriber the graph shows to match
+its publishers, and checks that again after its settle time.
 
 The loop's own subscriptions are best effort (compatible with a reliable publisher) with a deep
 queue: on one host nothing is lost in practice, and skipping the acknowledgements makes the
@@ -27,7 +30,7 @@ LOOP = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=LOOP_HISTORY,
     reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    durability=DurabilityPolicy.VOLATILE,
 )
 
 LOOP_IN = QoSProfile(
@@ -50,5 +53,5 @@ RECORD = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=LOOP_HISTORY,
     reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    durability=DurabilityPolicy.VOLATILE,
 )
