@@ -28,7 +28,7 @@ MS = 1_000_000
 N = 1500  # samples per topic: more than one second, so the recorder made the bag durable once
 
 # rosbag2 (jazzy) yaml.hpp: convert<BagMetadata>::decode for version 9, and its parts
-BAG_FIELDS = {
+BAG_FIELDS: dict[str, Any] = {
     "version": int,
     "storage_identifier": str,
     "duration": dict,
@@ -39,7 +39,7 @@ BAG_FIELDS = {
     "compression_format": str,
     "compression_mode": str,
     "files": list,
-    "custom_data": dict,
+    "custom_data": (dict, type(None)),  # an empty map is written as null (~), by rosbag2 too
     "ros_distro": str,
 }
 TOPIC_FIELDS = {
@@ -92,10 +92,10 @@ def recorded(path: Path, storage: str) -> Path:
     return path
 
 
-def check_fields(node: dict[str, Any], fields: dict[str, type], where: str) -> None:
+def check_fields(node: dict[str, Any], fields: dict[str, Any], where: str) -> None:
     for key, kind in fields.items():
         assert key in node, f"{where}: no {key}"
-        assert isinstance(node[key], kind), f"{where}.{key}: {node[key]!r} is not {kind.__name__}"
+        assert isinstance(node[key], kind), f"{where}.{key}: {node[key]!r} is not {kind}"
 
 
 def check_metadata(doc: dict[str, Any], storage: str) -> dict[str, Any]:
@@ -111,7 +111,7 @@ def check_metadata(doc: dict[str, Any], storage: str) -> dict[str, Any]:
         assert isinstance(t["message_count"], int)
     for i, f in enumerate(meta["files"]):
         check_fields(f, FILE_FIELDS, f"files[{i}]")
-    assert all(isinstance(v, str) for v in meta["custom_data"].values())
+    assert all(isinstance(v, str) for v in (meta["custom_data"] or {}).values())
     total = sum(t["message_count"] for t in meta["topics_with_message_count"])
     assert meta["message_count"] == total == sum(f["message_count"] for f in meta["files"])
     return meta
@@ -179,3 +179,85 @@ def test_a_recovered_bag_is_what_rosbag2_jazzy_reads(tmp_path: Path, storage: st
     got = recover(bag)
     assert got.messages == 2 * N + 1
     check_bag(got.out, storage)
+
+
+def as_ros2_bag_records_it(src: Path, dst: Path, storage: str) -> None:
+    """``src`` rewritten as ``ros2 bag record`` of the running graph holds it: every topic with
+    the publishers' offered QoS, no parameter snapshots (it records only live events), no custom
+    data of ours."""
+    from rosbags.interfaces import (
+        Qos,
+        QosDurability,
+        QosHistory,
+        QosLiveliness,
+        QosReliability,
+        QosTime,
+    )
+    from rosbags.rosbag2 import Reader
+
+    from haptic_dob.bag.write import open_writer
+    from haptic_msgs_py.ros.qos import LOOP_HISTORY
+
+    never = QosTime(0x7FFFFFFF, 0xFFFFFFFF)
+    offered = Qos(
+        QosHistory.KEEP_LAST,
+        LOOP_HISTORY,
+        QosReliability.RELIABLE,
+        QosDurability.VOLATILE,
+        never,
+        never,
+        QosLiveliness.AUTOMATIC,
+        never,
+        False,
+    )
+    writer = open_writer(dst, storage)
+    with Reader(src) as reader:
+        conns = [c for c in reader.connections if c.topic != "/parameter_events"]
+        added = {
+            c.id: writer.add_connection(
+                c.topic, c.msgtype, typestore=wire.TYPESTORE, offered_qos_profiles=[offered]
+            )
+            for c in conns
+        }
+        for conn, t, data in reader.messages(conns):
+            writer.write(added[conn.id], t, data)
+    writer.close()
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_a_bag_as_ros2_bag_records_it_goes_through_the_analyses(
+    tmp_path: Path, storage: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """No parameter snapshots: the wall stiffness comes from ``--stiffness``; the figures equal
+    those of our own recording of the same session, and the model is identified from it."""
+    from bagdata import session_params
+    from haptic_dob.bag.analyze import AnalysisSettings, analyze_bag
+    from haptic_dob.bag.write import write_session_bag
+    from haptic_dob.control import ControlMode, ImpedanceLaw
+    from haptic_dob.identify_cli import main as identify
+    from haptic_sim.session import SessionConfig, run_session
+
+    cfg = SessionConfig.from_yaml(Path(__file__).parents[1] / "config" / "slide_sim.yaml")
+    res = run_session(
+        cfg.replace(law=ImpedanceLaw(ControlMode.OL, 0.0, 4.0), loop__duration_s=12.0)
+    )
+    ours = tmp_path / "ours"
+    write_session_bag(
+        ours,
+        res.q,
+        res.force_measured,
+        1000.0,
+        session_params("OL", 0.0, 800.0),
+        velocity=res.qd,
+        storage=storage,
+        all_topics=True,
+    )
+    theirs = tmp_path / "theirs"
+    as_ros2_bag_records_it(ours, theirs, storage)
+    check_metadata(yaml.safe_load((theirs / "metadata.yaml").read_text()), storage)
+    (want,) = analyze_bag(ours).segments
+    (got,) = analyze_bag(theirs, settings=AnalysisSettings(stiffness_n_per_m=800.0)).segments
+    for key in ("bandwidth_hz", "impedance_error_pct", "coherence_in_band", "max_active_energy_j"):
+        assert got.as_dict()[key] == want.as_dict()[key], key
+    assert identify([str(theirs), "--json"]) == 0
+    assert '"mass_kg"' in capsys.readouterr().out
