@@ -301,3 +301,37 @@ def test_a_late_echo_sees_the_live_stream_not_a_replay(monkeypatch) -> None:
         echo.destroy_node()
         dev.destroy_node()
         rclpy.try_shutdown(context=ctx)
+
+
+@pytest.mark.parametrize(
+    ("cls", "topic"),
+    [
+        (DeviceNode, "/effort_command"),
+        (EnvironmentNode, "/ee_pose"),
+        (ControllerNode, "/wrench_desired"),
+    ],
+    ids=lambda x: getattr(x, "__name__", x),
+)
+@pytest.mark.parametrize("asked", [None, "best_effort"])
+def test_loop_inputs_are_reliable_unless_asked(monkeypatch, cls, topic, asked) -> None:
+    """A one-off ``ros2 topic pub --once`` must arrive: the loop's inputs are reliable, as
+    ``ros2 topic info -v`` shows; ``input_reliability:=best_effort`` trades that for speed."""
+    from rclpy.qos import ReliabilityPolicy
+
+    monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
+    ctx = Context()
+    args = [] if asked is None else ["--ros-args", "-p", f"input_reliability:={asked}"]
+    rclpy.init(context=ctx, args=args)
+    node = cls(context=ctx)
+    try:
+
+        def reliabilities() -> set[ReliabilityPolicy]:
+            infos = node.get_subscriptions_info_by_topic(topic)
+            return {i.qos_profile.reliability for i in infos if i.node_name == node.get_name()}
+
+        assert wait_until(reliabilities, 10)
+        want = ReliabilityPolicy.BEST_EFFORT if asked else ReliabilityPolicy.RELIABLE
+        assert reliabilities() == {want}
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown(context=ctx)

@@ -40,3 +40,6 @@ SESSION_TOPICS: dict[str, str] = {
 }
 
 DEFAULT_BASE_FRAME = "base_link"
+
+#: choices of a loop node's ``input_reliability`` (QoS of its loop inputs, ``ros.qos.loop_input``)
+INPUT_RELIABILITY = ("reliable", "best_effort")

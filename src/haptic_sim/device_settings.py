@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from haptic_dob.models.factory import model_specs
-from haptic_dob.nodes.common import CLOCK_MODES, loop_specs, process_specs
+from haptic_dob.nodes.common import CLOCK_MODES, input_specs, loop_specs, process_specs
 from haptic_dob.runtime.params import ParamSpec
 from haptic_sim.factory import simulation_specs
 
@@ -26,6 +26,7 @@ def device_node_specs() -> list[ParamSpec]:
     return [
         *safety_specs(),
         *loop_specs(),
+        *input_specs(),
         *process_specs(),
         *model_specs(),
         ParamSpec(

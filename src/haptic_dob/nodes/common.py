@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from haptic_dob.runtime.params import ParamSpec
-from haptic_msgs_py.topics import DEFAULT_BASE_FRAME
+from haptic_msgs_py.topics import DEFAULT_BASE_FRAME, INPUT_RELIABILITY
 
 CLOCK_MODES = ("lockstep", "realtime")
 
@@ -15,6 +15,23 @@ def loop_specs() -> list[ParamSpec]:
         ParamSpec(
             "base_frame", DEFAULT_BASE_FRAME, "frame of poses, twists and wrenches", read_only=True
         ),
+    ]
+
+
+def input_specs() -> list[ParamSpec]:
+    """How a node with loop inputs subscribes to them (device, environment, controller)."""
+    return [
+        ParamSpec(
+            "input_reliability",
+            "reliable",
+            "QoS reliability of this node's loop inputs: reliable (a one-off message such as "
+            "ros2 topic pub --once always arrives) or best_effort (no acknowledgements: nodes in "
+            "separate processes cycle faster, see BENCHMARKS.md; a message sent before the "
+            "reader matched its writer can be lost). Nodes sharing a process hand values over "
+            "in process either way",
+            choices=INPUT_RELIABILITY,
+            read_only=True,
+        )
     ]
 
 

@@ -33,7 +33,7 @@ from rclpy.context import Context
 from haptic_dob.control import ImpedanceController, ImpedanceLaw
 from haptic_dob.cycle import FALLBACKS, CommandJoin
 from haptic_dob.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import loop_specs, main_for, process_specs
+from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
 from haptic_dob.nodes.observer_node import JointMap, pick
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
@@ -56,6 +56,7 @@ def controller_node_specs() -> list[ParamSpec]:
     """Every parameter of the controller node."""
     return [
         *loop_specs(),
+        *input_specs(),
         *process_specs(),
         *model_specs(),
         *specs_of(ImpedanceLaw),
@@ -127,8 +128,9 @@ class ControllerNode(LoopNode):
             inputs.append((WRENCH_ESTIMATE, codecs.WRENCH, self._on_estimated))
         if self.join.needs_q:
             inputs.append((JOINT_STATES, codecs.JOINT_STATE, self._on_joint_states))
+        profile = qos.loop_input(values["input_reliability"])
         for topic, codec, callback in inputs:
-            LoopSubscription(self, topic, codec, callback, qos.LOOP_IN)
+            LoopSubscription(self, topic, codec, callback, profile)
         self.diagnostics = Diagnostics(self, self._report)
 
     @property

@@ -10,7 +10,7 @@ from rclpy.context import Context
 
 from haptic_dob.cycle import wall_force
 from haptic_dob.environment import VirtualWall
-from haptic_dob.nodes.common import loop_specs, main_for, process_specs
+from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
@@ -24,7 +24,7 @@ from haptic_msgs_py.values import StampedVector
 
 def environment_node_specs() -> list[ParamSpec]:
     """Every parameter of the environment node (the wall's change at run time)."""
-    return [*loop_specs(), *process_specs(), *specs_of(VirtualWall)]
+    return [*loop_specs(), *input_specs(), *process_specs(), *specs_of(VirtualWall)]
 
 
 class EnvironmentNode(LoopNode):
@@ -41,8 +41,9 @@ class EnvironmentNode(LoopNode):
         self._pub = LoopPublisher(
             self, WRENCH_DESIRED, codecs.WRENCH, qos.LOOP, self.params.values["base_frame"]
         )
-        LoopSubscription(self, EE_POSE, codecs.POSE, self._on_pose, qos.LOOP_IN)
-        LoopSubscription(self, EE_TWIST, codecs.TWIST, self._on_twist, qos.LOOP_IN)
+        inputs = qos.loop_input(self.params.values["input_reliability"])
+        LoopSubscription(self, EE_POSE, codecs.POSE, self._on_pose, inputs)
+        LoopSubscription(self, EE_TWIST, codecs.TWIST, self._on_twist, inputs)
         self.diagnostics = Diagnostics(self, self._report)
 
     def _report(self) -> Report:

@@ -8,13 +8,16 @@ sees the live stream at once, not a replay. A reader that must have every sample
 (``haptic-launch --record`` adds the recorder) and for every subscriber the graph shows to match
 its publishers, and checks that again after its settle time.
 
-The loop's own subscriptions are best effort (compatible with a reliable publisher) with a deep
-queue: on one host nothing is lost in practice, and skipping the acknowledgements makes the
-lockstep cycle about 25 % faster on a 2-core machine (BENCHMARKS.md). A lost sample on the
-critical path of a lockstep run stalls it until the device re-sends the sample after
-``lockstep_timeout_s``; every node answers a repeated sample idempotently, so the run stays
-exact. The observer's input is reliable (``ESTIMATOR_IN``): off the critical path in OL and CL
-it may lag on a loaded machine, and a sample lost there would be a permanent gap in the recorded
+The loop's own subscriptions (``loop_input``) are reliable by default, with a deep queue: a
+person's one-off message (``ros2 topic pub --once`` to a command input) arrives even when it was
+sent before the reader had matched the new writer, which a best-effort reader drops. A node's
+``input_reliability`` parameter can make them best effort instead: no acknowledgements, so nodes
+in separate processes cycle faster (BENCHMARKS.md measures it); a sample lost on the critical
+path of a lockstep run then stalls it until the device re-sends the sample after
+``lockstep_timeout_s`` (every node answers a repeated sample idempotently, so the run stays
+exact). Nodes sharing a process hand the loop's values over in process either way. The
+observer's input is always reliable (``ESTIMATOR_IN``): off the critical path in OL and CL it may
+lag on a loaded machine, and a sample lost there would be a permanent gap in the recorded
 estimate; reliable delivery repairs it from the publisher's history. The observer counts gaps in
 the samples it receives.
 """
@@ -22,6 +25,8 @@ the samples it receives.
 from __future__ import annotations
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+from haptic_msgs_py.topics import INPUT_RELIABILITY
 
 LOOP_HISTORY = 2000  # samples a loop publisher keeps for late or slow reliable readers
 LOOP_IN_DEPTH = 1000  # samples a loop subscription queues (a node off the critical path may lag)
@@ -36,9 +41,26 @@ LOOP = QoSProfile(
 LOOP_IN = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=LOOP_IN_DEPTH,
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.VOLATILE,
+)
+
+LOOP_IN_BEST_EFFORT = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=LOOP_IN_DEPTH,
     reliability=ReliabilityPolicy.BEST_EFFORT,
     durability=DurabilityPolicy.VOLATILE,
 )
+
+
+def loop_input(reliability: str) -> QoSProfile:
+    """The loop subscriptions' profile for ``input_reliability`` (``INPUT_RELIABILITY``)."""
+    if reliability not in INPUT_RELIABILITY:
+        raise ValueError(
+            f"input_reliability must be one of {INPUT_RELIABILITY}, got {reliability!r}"
+        )
+    return LOOP_IN if reliability == "reliable" else LOOP_IN_BEST_EFFORT
+
 
 ESTIMATOR_IN = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,

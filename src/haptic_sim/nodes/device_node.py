@@ -92,9 +92,8 @@ class DeviceNode(LoopNode):
         # the sample's stamp as ROS time, in both clock modes: tools with use_sim_time (ros2 bag
         # record --use-sim-time, a node's -p use_sim_time:=true) share the loop's time base
         self._p_clock = LoopPublisher(self, CLOCK, codecs.CLOCK, qos.CLOCK, on_demand=True)
-        self._sub = LoopSubscription(
-            self, EFFORT_COMMAND, codecs.EFFORT, self.loop.command, qos.LOOP_IN
-        )
+        inputs = qos.loop_input(v["input_reliability"])
+        self._sub = LoopSubscription(self, EFFORT_COMMAND, codecs.EFFORT, self.loop.command, inputs)
         self._bus = self._sub.bus
         if self.lockstep:
             raw_subscription(
