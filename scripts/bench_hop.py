@@ -15,12 +15,13 @@ from bench_pattern import peer_node
 
 def _hop_peer(role: str, n: int, domain: str, out: Any) -> None:
     """One side of the ping-pong: ``a`` sends and times, ``b`` echoes (raw bytes, events
-    executor, the loop's QoS: reliable transient-local publisher, best-effort subscription)."""
+    executor, the loop's QoS: reliable volatile publisher, best-effort subscription as the
+    sensor streams take it)."""
     ctx, node, ex = peer_node(f"hop_{role}", domain)
     from std_msgs.msg import Header
 
     from haptic_msgs_py import wire
-    from haptic_msgs_py.ros.qos import LOOP, LOOP_IN
+    from haptic_msgs_py.ros.qos import LOOP, LOOP_IN_BEST_EFFORT
 
     send, receive = ("ping", "pong") if role == "a" else ("pong", "ping")
     pub = node.create_publisher(Header, send, LOOP)
@@ -35,7 +36,7 @@ def _hop_peer(role: str, n: int, domain: str, out: Any) -> None:
             rtts.append(time.perf_counter() - state["t"])
             state["got"] += 1
 
-    node.create_subscription(Header, receive, on_data, LOOP_IN, raw=True)
+    node.create_subscription(Header, receive, on_data, LOOP_IN_BEST_EFFORT, raw=True)
     ex.add_node(node)
     end = time.monotonic() + 30.0
     while pub.get_subscription_count() < 1 and time.monotonic() < end:

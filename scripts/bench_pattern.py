@@ -50,7 +50,7 @@ def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
     from std_msgs.msg import Header
 
     from haptic_msgs_py import wire
-    from haptic_msgs_py.ros.qos import ESTIMATOR_IN, LOOP, LOOP_IN
+    from haptic_msgs_py.ros.qos import ESTIMATOR_IN, LOOP, LOOP_IN, LOOP_IN_BEST_EFFORT
 
     data = wire.encode(wire.header("base_link"))
     sends, waits = ROLES[role]
@@ -75,11 +75,13 @@ def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
 
         return callback
 
+    # the nodes' default input QoS: the device's command input reliable, the sensor streams best
+    # effort, the observer's input reliable
+    qos = {"observer": ESTIMATOR_IN, "device": LOOP_IN}.get(role, LOOP_IN_BEST_EFFORT)
     for t in waits:
-        qos = ESTIMATOR_IN if role == "observer" else LOOP_IN
         node.create_subscription(Header, t, on(t), qos, raw=True)
     if role == "controller":  # taken, not waited for
-        node.create_subscription(Header, "wrench_measured", lambda _m: None, LOOP_IN, raw=True)
+        node.create_subscription(Header, "wrench_measured", lambda _m: None, qos, raw=True)
     ex.add_node(node)
     settle = time.monotonic() + 5.0  # discovery and matching of every endpoint
     while time.monotonic() < settle:

@@ -304,18 +304,21 @@ def test_a_late_echo_sees_the_live_stream_not_a_replay(monkeypatch) -> None:
 
 
 @pytest.mark.parametrize(
-    ("cls", "topic"),
+    ("cls", "topic", "default"),
     [
-        (DeviceNode, "/effort_command"),
-        (EnvironmentNode, "/ee_pose"),
-        (ControllerNode, "/wrench_desired"),
+        (DeviceNode, "/effort_command", "reliable"),
+        (EnvironmentNode, "/ee_pose", "best_effort"),
+        (ControllerNode, "/wrench_desired", "best_effort"),
     ],
     ids=lambda x: getattr(x, "__name__", x),
 )
-@pytest.mark.parametrize("asked", [None, "best_effort"])
-def test_loop_inputs_are_reliable_unless_asked(monkeypatch, cls, topic, asked) -> None:
-    """A one-off ``ros2 topic pub --once`` must arrive: the loop's inputs are reliable, as
-    ``ros2 topic info -v`` shows; ``input_reliability:=best_effort`` trades that for speed."""
+@pytest.mark.parametrize("asked", [None, "reliable", "best_effort"])
+def test_the_command_input_is_reliable_and_sensor_streams_best_effort(
+    monkeypatch, cls, topic, default, asked
+) -> None:
+    """A one-off ``ros2 topic pub --once`` to the device's command input must arrive: it is
+    reliable, as ``ros2 topic info -v`` shows; the sensor streams are best effort (ROS 2's
+    sensor-data convention, faster between processes); ``input_reliability`` chooses."""
     from rclpy.qos import ReliabilityPolicy
 
     monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
@@ -330,8 +333,11 @@ def test_loop_inputs_are_reliable_unless_asked(monkeypatch, cls, topic, asked) -
             return {i.qos_profile.reliability for i in infos if i.node_name == node.get_name()}
 
         assert wait_until(reliabilities, 10)
-        want = ReliabilityPolicy.BEST_EFFORT if asked else ReliabilityPolicy.RELIABLE
-        assert reliabilities() == {want}
+        policy = {
+            "reliable": ReliabilityPolicy.RELIABLE,
+            "best_effort": ReliabilityPolicy.BEST_EFFORT,
+        }
+        assert reliabilities() == {policy[asked or default]}
     finally:
         node.destroy_node()
         rclpy.try_shutdown(context=ctx)

@@ -26,7 +26,7 @@ def device_node_specs() -> list[ParamSpec]:
     return [
         *safety_specs(),
         *loop_specs(),
-        *input_specs(),
+        *input_specs("reliable"),
         *process_specs(),
         *model_specs(),
         ParamSpec(

@@ -18,15 +18,18 @@ def loop_specs() -> list[ParamSpec]:
     ]
 
 
-def input_specs() -> list[ParamSpec]:
-    """How a node with loop inputs subscribes to them (device, environment, controller)."""
+def input_specs(default: str) -> list[ParamSpec]:
+    """How a node with loop inputs subscribes to them: ``default`` is ``reliable`` for a command
+    input (the device's ``effort_command``), ``best_effort`` for sensor streams (environment,
+    controller), as ROS 2 treats commands and sensor data."""
     return [
         ParamSpec(
             "input_reliability",
-            "reliable",
+            default,
             "QoS reliability of this node's loop inputs: reliable (a one-off message such as "
-            "ros2 topic pub --once always arrives) or best_effort (no acknowledgements: nodes in "
-            "separate processes cycle faster, see BENCHMARKS.md; a message sent before the "
+            "ros2 topic pub --once always arrives; the default of the device's effort_command) "
+            "or best_effort (no acknowledgements, the default of the sensor streams: nodes in "
+            "separate processes cycle faster, see BENCHMARKS.md, and a message sent before the "
             "reader matched its writer can be lost). Nodes sharing a process hand values over "
             "in process either way",
             choices=INPUT_RELIABILITY,

@@ -56,7 +56,7 @@ def controller_node_specs() -> list[ParamSpec]:
     """Every parameter of the controller node."""
     return [
         *loop_specs(),
-        *input_specs(),
+        *input_specs("best_effort"),
         *process_specs(),
         *model_specs(),
         *specs_of(ImpedanceLaw),

@@ -24,7 +24,7 @@ from haptic_msgs_py.values import StampedVector
 
 def environment_node_specs() -> list[ParamSpec]:
     """Every parameter of the environment node (the wall's change at run time)."""
-    return [*loop_specs(), *input_specs(), *process_specs(), *specs_of(VirtualWall)]
+    return [*loop_specs(), *input_specs("best_effort"), *process_specs(), *specs_of(VirtualWall)]
 
 
 class EnvironmentNode(LoopNode):

@@ -8,13 +8,14 @@ sees the live stream at once, not a replay. A reader that must have every sample
 (``haptic-launch --record`` adds the recorder) and for every subscriber the graph shows to match
 its publishers, and checks that again after its settle time.
 
-The loop's own subscriptions (``loop_input``) are reliable by default, with a deep queue: a
-person's one-off message (``ros2 topic pub --once`` to a command input) arrives even when it was
-sent before the reader had matched the new writer, which a best-effort reader drops. A node's
-``input_reliability`` parameter can make them best effort instead: no acknowledgements, so nodes
-in separate processes cycle faster (BENCHMARKS.md measures it); a sample lost on the critical
-path of a lockstep run then stalls it until the device re-sends the sample after
-``lockstep_timeout_s`` (every node answers a repeated sample idempotently, so the run stays
+The loop's own subscriptions (``loop_input``, a node's ``input_reliability``) have a deep queue.
+The command input (the device's ``effort_command``) is reliable by default: a person's one-off
+message (``ros2 topic pub --once``) arrives even when it was sent before the reader had matched
+the new writer, which a best-effort reader drops. The sensor streams (the environment's and the
+controller's inputs) are best effort by default, as ROS 2's sensor-data profile: no
+acknowledgements, so nodes in separate processes cycle faster (BENCHMARKS.md measures both); a
+sample lost on the critical path of a lockstep run stalls it until the device re-sends the sample
+after ``lockstep_timeout_s`` (every node answers a repeated sample idempotently, so the run stays
 exact). Nodes sharing a process hand the loop's values over in process either way. The
 observer's input is always reliable (``ESTIMATOR_IN``): off the critical path in OL and CL it may
 lag on a loaded machine, and a sample lost there would be a permanent gap in the recorded
