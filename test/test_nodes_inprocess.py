@@ -266,6 +266,7 @@ def test_a_late_echo_sees_the_live_stream_not_a_replay(monkeypatch) -> None:
     echo`` does, gets the newest samples at once, not up to 2000 old ones (issue: late echo)."""
     import time
 
+    from rclpy.event_handler import SubscriptionEventCallbacks
     from rclpy.qos import QoSProfile
     from sensor_msgs.msg import JointState
 
@@ -286,8 +287,14 @@ def test_a_late_echo_sees_the_live_stream_not_a_replay(monkeypatch) -> None:
         (offered,) = echo.get_publishers_info_by_topic("/joint_states")
         qos = QoSProfile(depth=10, durability=offered.qos_profile.durability)  # as echo adapts
         got: list[int] = []
+        lost: list[int] = []  # ros2 topic echo prints "A message was lost!!!" on these events
+        events = SubscriptionEventCallbacks(message_lost=lambda e: lost.append(e.total_count))
         echo.create_subscription(
-            JointState, "/joint_states", lambda m: got.append(stamp_ns(m)), qos
+            JointState,
+            "/joint_states",
+            lambda m: got.append(stamp_ns(m)),
+            qos,
+            event_callbacks=events,
         )
 
         def tick_and_spin() -> None:
@@ -296,6 +303,7 @@ def test_a_late_echo_sees_the_live_stream_not_a_replay(monkeypatch) -> None:
 
         assert wait_until(lambda: len(got) >= 5, 30, step=tick_and_spin)
         assert got[0] >= joined_k * dev.device.period_ns, (got[:5], joined_k)
+        assert not lost, f"{lost[-1]} messages reported lost"
     finally:
         ex.shutdown()
         echo.destroy_node()
