@@ -1,9 +1,8 @@
 """recorder_node: record a session into a rosbag2 (MCAP or sqlite3) with the ``rosbags`` writer.
 
-- Subscribes raw (serialized CDR) to each topic and writes the bytes as they are: reliable
-  ``qos.RECORD`` with a 2000-sample queue for the loop's topics (the publishers repair what a
-  lagging recorder missed from their history; the device waits for the recorder to match before
-  sample 0 when the recorder is in its ``wait_for``), the parameter-events profile for
+- Subscribes raw (serialized CDR) to each topic and writes the bytes as they are: reliable,
+  transient-local ``qos.RECORD`` for the loop's topics (a late match still gets the publishers'
+  last 2000 samples), the parameter-events profile for
   ``/parameter_events``, reliable volatile for other topics. Bag time is the receive time (wall
   clock, ns); the analysis times samples by their header stamps.
 - Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``;

@@ -1,12 +1,14 @@
 """QoS profiles of the haptic loop.
 
-Loop publishers are reliable and volatile and keep the last 2000 samples: a reliable reader that
-falls behind (a recorder on a loaded machine) gets every sample repaired from that history, by up
-to 2000 samples (2 s at 1 kHz), and a reader that joins late (``ros2 topic echo``, a plot, RViz)
-sees the live stream at once, not a replay. A reader that must have every sample from the first
-(the recorder) is matched before sample 0: the device waits for the nodes in its ``wait_for``
-(``haptic-launch --record`` adds the recorder) and for every subscriber the graph shows to match
-its publishers, and checks that again after its settle time.
+Loop publishers are reliable and transient-local and keep the last 2000 samples: a recorder
+(which must not lose a sample) subscribing reliable + transient-local gets every sample even when
+its subscription matched a publisher late after start-up (endpoint matching between processes
+takes a moment, and a reader can match a writer some time after the writer matched it) or fell
+behind, by up to 2000 samples (2 s at 1 kHz). The price: a late reader that asks for the
+publisher's durability (``ros2 topic echo`` adapts to it) is first sent that history. Volatile
+publishers would spare it, but then a recorder whose reader matched a writer after that writer
+had matched it (and sent) loses those samples; the device's start gate sees only its own side of
+a match, so that needs a handshake from the reader first.
 
 The loop's own subscriptions (``loop_input``, a node's ``input_reliability``) have a deep queue.
 The command input (the device's ``effort_command``) is reliable by default: a person's one-off
@@ -36,7 +38,7 @@ LOOP = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=LOOP_HISTORY,
     reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.VOLATILE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
 )
 
 LOOP_IN = QoSProfile(
@@ -76,5 +78,5 @@ RECORD = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=LOOP_HISTORY,
     reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.VOLATILE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
 )
