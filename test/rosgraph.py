@@ -99,6 +99,12 @@ class Collector:
     ``records[topic]`` is a list of (receive time, CDR bytes); ``messages(topic)`` decodes them.
     Subscriptions are reliable, so a collector added to the device's ``wait_for`` sees every
     sample of a lockstep run. Storing bytes keeps it fast enough for several 2 kHz topics.
+
+    A collector of the device's ``joint_states`` reports its progress as a recorder does
+    (``recorder/progress``, 50 times a second: the newest stamp received, minimum over its
+    stamped topics still flowing), so a lockstep device waits for it when a loaded machine leaves
+    it behind, instead of running past the publishers' history (``back_pressure=False`` turns
+    that off).
     """
 
     def __init__(
@@ -107,13 +113,17 @@ class Collector:
         topics: dict[str, str],
         name: str = "collector",
         namespace: str = "",
+        back_pressure: bool = True,
     ) -> None:
         import rclpy
         from rclpy.context import Context
         from rclpy.experimental import EventsExecutor
 
-        from haptic_msgs_py.ros.qos import RECORD
+        from haptic_dob.recorder.counts import RecordingCounts
+        from haptic_dob.recorder.topics import stamp_reader
+        from haptic_msgs_py.ros.qos import CLOCK, RECORD
         from haptic_msgs_py.ros.raw import rclpy_type
+        from haptic_msgs_py.topics import JOINT_STATES, RECORDER_PROGRESS, SESSION_TOPICS
 
         self._saved = {
             k: os.environ.get(k) for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")
@@ -131,8 +141,6 @@ class Collector:
         )
         from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-        from haptic_msgs_py.topics import SESSION_TOPICS
-
         # loop topics: reliable + transient local (late matching loses nothing); others, such as
         # /diagnostics, are offered volatile
         volatile = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
@@ -140,16 +148,38 @@ class Collector:
         self.records: dict[str, list[tuple[float, bytes]]] = {t: [] for t in topics}
         self._lock = threading.Lock()
         self._subs: dict[str, Any] = {}
+        self.counts = RecordingCounts()
         for topic, typename in topics.items():
+            count = self.counts.add_topic(topic, typename)
+            # the loop's topics carry the loop's stamps; others (/diagnostics) the node's clock
+            loop_topic = topic.rsplit("/", 1)[-1] in SESSION_TOPICS
+            read_stamp = stamp_reader(topic, typename) if loop_topic else None
 
-            def cb(data: bytes, topic: str = topic) -> None:
+            def cb(
+                data: bytes, topic: str = topic, count: Any = count, read: Any = read_stamp
+            ) -> None:
                 with self._lock:
                     self.records[topic].append((time.monotonic(), data))
+                    if read is not None:
+                        count.wrote(read(data), 1_000_000)
 
             qos = RECORD if topic in SESSION_TOPICS else volatile
             self._subs[topic] = self.node.create_subscription(
                 rclpy_type(typename), topic, cb, qos, raw=True
             )
+        if back_pressure and any(t.rsplit("/", 1)[-1] == JOINT_STATES for t in topics):
+            from std_msgs.msg import Header
+
+            progress = self.node.create_publisher(Header, RECORDER_PROGRESS, CLOCK)
+            msg = Header(frame_id=self.node.get_fully_qualified_name())
+
+            def report() -> None:
+                with self._lock:
+                    ns = self.counts.progress_ns()
+                msg.stamp.sec, msg.stamp.nanosec = divmod(ns, 1_000_000_000)
+                progress.publish(msg)
+
+            self.node.create_timer(0.02, report)
         # the events executor (as the nodes use): a loaded machine must not leave this test's
         # own subscriber more than the publishers' 2000-sample history behind
         self.executor = EventsExecutor(context=self.context)

@@ -2,9 +2,14 @@
 types it at a device running alone in lockstep, steps the device by one sample every time.
 
 The publisher is made as ``ros2 topic pub --once`` makes it (reliable, the default QoS): a new
-process, it waits until it has matched a subscription, publishes once, keeps its node alive a
-moment (``--keep-alive``, 0.1 s) and exits. A best-effort reader can drop that message when it has
-not yet matched the new writer itself; the loop's inputs are reliable, so none is lost.
+process, it waits until it has matched a subscription, publishes once and exits. A reader can
+match the new writer after the writer matched it and sent: a best-effort reader then drops the
+message for good; a reliable one asks for it again and acknowledges it. The loop's inputs are
+reliable, so the publisher here stays until every matched reader has acknowledged (at most 10 s)
+instead of ``ros2 topic pub``'s fixed ``--keep-alive`` of 0.1 s, which a busy machine can outrun
+(a fresh-clone CI run lost command 8 of 8 that way); docs/running.md says to pass
+``--keep-alive 1.0`` there. Against a best-effort reader the wait returns at once (best-effort
+readers never acknowledge) and a late-matched command is lost, which this test would catch.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 ONCE = """
 import time
 import rclpy
+from rclpy.duration import Duration
 from std_msgs.msg import Float64MultiArray
 rclpy.init()
 node = rclpy.create_node("topic_pub_once")
@@ -31,7 +37,8 @@ end = time.monotonic() + 30.0
 while pub.get_subscription_count() < 1 and time.monotonic() < end:
     time.sleep(0.001)
 pub.publish(Float64MultiArray(data=[0.1]))
-time.sleep(0.1)
+if not pub.wait_for_all_acked(Duration(seconds=10.0)):
+    raise SystemExit("the one-off command was not acknowledged within 10 s")
 node.destroy_node()
 rclpy.shutdown()
 """

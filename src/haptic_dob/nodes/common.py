@@ -27,7 +27,8 @@ def input_specs(default: str) -> list[ParamSpec]:
             "input_reliability",
             default,
             "QoS reliability of this node's loop inputs: reliable (a one-off message such as "
-            "ros2 topic pub --once always arrives; the default of the device's effort_command) "
+            "ros2 topic pub --once is asked for again and arrives while its publisher lives; "
+            "the default of the device's effort_command) "
             "or best_effort (no acknowledgements, the default of the sensor streams: nodes in "
             "separate processes cycle faster, see BENCHMARKS.md, and a message sent before the "
             "reader matched its writer can be lost). Nodes sharing a process hand values over "
