@@ -100,11 +100,12 @@ class Collector:
     Subscriptions are reliable, so a collector added to the device's ``wait_for`` sees every
     sample of a lockstep run. Storing bytes keeps it fast enough for several 2 kHz topics.
 
-    A collector of the device's ``joint_states`` reports its progress as a recorder does
+    A collector of the loop's topics reports its progress as a recorder does
     (``recorder/progress``, 50 times a second: the newest stamp received, minimum over its
-    stamped topics still flowing), so a lockstep device waits for it when a loaded machine leaves
-    it behind, instead of running past the publishers' history (``back_pressure=False`` turns
-    that off).
+    stamped topics still flowing; before the first sample, whether its readers have matched), so
+    the device sends sample 0 only once it has matched and a lockstep device waits for it when a
+    loaded machine leaves it behind, instead of running past the publishers' history
+    (``back_pressure=False`` turns that off, e.g. for topics that stop while the loop goes on).
     """
 
     def __init__(
@@ -123,7 +124,7 @@ class Collector:
         from haptic_dob.recorder.topics import stamp_reader
         from haptic_msgs_py.ros.qos import CLOCK, RECORD
         from haptic_msgs_py.ros.raw import rclpy_type
-        from haptic_msgs_py.topics import JOINT_STATES, RECORDER_PROGRESS, SESSION_TOPICS
+        from haptic_msgs_py.topics import RECORDER_PROGRESS, SESSION_TOPICS
 
         self._saved = {
             k: os.environ.get(k) for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")
@@ -141,8 +142,7 @@ class Collector:
         )
         from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-        # loop topics: reliable + transient local (late matching loses nothing); others, such as
-        # /diagnostics, are offered volatile
+        # loop topics: as the recorder takes them; others, such as /diagnostics, reliable
         volatile = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
         self.topics = dict(topics)
         self.records: dict[str, list[tuple[float, bytes]]] = {t: [] for t in topics}
@@ -167,15 +167,24 @@ class Collector:
             self._subs[topic] = self.node.create_subscription(
                 rclpy_type(typename), topic, cb, qos, raw=True
             )
-        if back_pressure and any(t.rsplit("/", 1)[-1] == JOINT_STATES for t in topics):
+        if back_pressure and any(t.rsplit("/", 1)[-1] in SESSION_TOPICS for t in topics):
             from std_msgs.msg import Header
 
+            from haptic_dob.recorder.matching import ReaderMatch, reported_progress
+
             progress = self.node.create_publisher(Header, RECORDER_PROGRESS, CLOCK)
+            count_publishers = self.node.count_publishers
             msg = Header(frame_id=self.node.get_fully_qualified_name())
 
             def report() -> None:
+                readers = [
+                    ReaderMatch(
+                        s.topic_name, s.get_publisher_count(), count_publishers(s.topic_name)
+                    )
+                    for s in self._subs.values()
+                ]
                 with self._lock:
-                    ns = self.counts.progress_ns()
+                    ns = reported_progress(self.counts.progress_ns(), self.counts, readers)
                 msg.stamp.sec, msg.stamp.nanosec = divmod(ns, 1_000_000_000)
                 progress.publish(msg)
 

@@ -66,8 +66,9 @@ def test_lockstep_graph_equals_the_batch_run(root, tmp_path, mode: str, kf: floa
     assert np.max(np.abs(q_graph[:5000] - batch.q)) <= 1e-6
     assert np.array_equal(q_graph[:5000], batch.q)
     # every command seen, by its cycle label, is the batch's (the collector's subscription to the
-    # controller may match late on a loaded machine: transient-local history then gives it the
-    # last 2000; the applied efforts below cover every cycle)
+    # controller may match after the run started on a loaded machine, when the controller came
+    # into its graph after the device's second look: it then sees the commands from its match
+    # on; the applied efforts below cover every cycle)
     by_k = {command_stamp(c.layout.dim[0].label) // 1_000_000: c.data[0] for c in cmds}
     seen = sorted(k for k in by_k if k < 5000)
     assert len(seen) >= 2000 and seen == list(range(seen[0], 5000)), (len(seen), seen[:3])

@@ -261,6 +261,56 @@ def test_a_realtime_device_publishes_its_stamps_on_clock(monkeypatch) -> None:
         rclpy.try_shutdown(context=ctx)
 
 
+def test_a_late_echo_sees_the_live_stream_not_a_replay(monkeypatch) -> None:
+    """A reader that joins a running loop and takes the publisher's durability, as ``ros2 topic
+    echo`` does, gets the newest samples at once, not up to 2000 old ones (issue: late echo)."""
+    import time
+
+    from rclpy.event_handler import SubscriptionEventCallbacks
+    from rclpy.qos import QoSProfile
+    from sensor_msgs.msg import JointState
+
+    from haptic_msgs_py.stamps import stamp_ns
+
+    monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
+    ctx = Context()
+    rclpy.init(context=ctx, args=["--ros-args", "-p", "clock_mode:=realtime", "-p", "wait_for:=[]"])
+    dev = DeviceNode(context=ctx)
+    echo = rclpy.create_node("late_echo", context=ctx)
+    ex = SingleThreadedExecutor(context=ctx)
+    ex.add_node(echo)
+    ex.add_node(dev)
+    try:
+        for _ in range(300):
+            dev.on_wakeup(time.monotonic())
+        joined_k = dev.device.k
+        (offered,) = echo.get_publishers_info_by_topic("/joint_states")
+        qos = QoSProfile(depth=10, durability=offered.qos_profile.durability)  # as echo adapts
+        got: list[int] = []
+        lost: list[int] = []  # ros2 topic echo prints "A message was lost!!!" on these events
+        events = SubscriptionEventCallbacks(message_lost=lambda e: lost.append(e.total_count))
+        echo.create_subscription(
+            JointState,
+            "/joint_states",
+            lambda m: got.append(stamp_ns(m)),
+            qos,
+            event_callbacks=events,
+        )
+
+        def tick_and_spin() -> None:
+            dev.on_wakeup(time.monotonic())
+            ex.spin_once(0.01)
+
+        assert wait_until(lambda: len(got) >= 5, 30, step=tick_and_spin)
+        assert got[0] >= joined_k * dev.device.period_ns, (got[:5], joined_k)
+        assert not lost, f"{lost[-1]} messages reported lost"
+    finally:
+        ex.shutdown()
+        echo.destroy_node()
+        dev.destroy_node()
+        rclpy.try_shutdown(context=ctx)
+
+
 @pytest.mark.parametrize(
     ("cls", "topic", "default"),
     [

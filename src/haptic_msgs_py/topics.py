@@ -24,6 +24,9 @@ DIAGNOSTICS = "/diagnostics"  # diagnostic_msgs/DiagnosticArray
 # recorder -> device (lockstep back-pressure): the newest stamp written for every recorded topic
 # (std_msgs/Header: stamp, and the recorder's name in frame_id)
 RECORDER_PROGRESS = "recorder/progress"
+# progress stamp of a recorder whose readers have not all matched their writers yet (-1 s): the
+# device does not send sample 0 while a recorder says this (the loop's topics are volatile)
+PROGRESS_NOT_MATCHED_NS = -1_000_000_000
 PARAMETER_EVENTS = "/parameter_events"  # rcl_interfaces/ParameterEvent
 
 #: the topics of one session and their message types (what the recorder records)

@@ -254,11 +254,14 @@ class DeviceLoop:
             self.lockstep_timeout(now)
 
     def graph_ready(self) -> bool:
-        """Every ``wait_for`` node is up, known subscribers matched, a command publisher seen.
+        """Every ``wait_for`` node is up, known subscribers matched, a command publisher seen,
+        every recorder's readers matched.
 
         While not, says what it waits for (every 5 s), so a device that does not start says why.
         """
         waiting = self.port.waiting_for()
+        if not waiting and self.recorders.unmatched(self.port.recorders()):
+            waiting = "the recorders' readers to match the loop's topics"
         if waiting:
             self.log.info(
                 f"waiting before sample 0 for {waiting} (wait_for: {list(self.settings.wait_for)})",

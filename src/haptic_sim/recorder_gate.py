@@ -1,10 +1,12 @@
 """Lockstep back-pressure from recorders: a recording of a lockstep run never loses a sample.
 
 Each recorder reports the newest stamp it has written (``recorder/progress``, at least 20 times a
-second). The gate follows the slowest recorder that still reports (one silent for ``stale_s`` no
-longer holds the loop), holds command k while that recorder lags more than the allowed simulated
-time behind sample k, and at the end of a run tells when the last sample is written (or the
-drain time is up).
+second), or, before it has written anything, that its readers have not all matched their writers
+yet (``PROGRESS_NOT_MATCHED_NS``): the loop's topics are volatile, so the device sends sample 0
+only once every recorder has said it matched (``unmatched``). The gate follows the slowest
+recorder that still reports (one silent for ``stale_s`` no longer holds the loop), holds command
+k while that recorder lags more than the allowed simulated time behind sample k, and at the end
+of a run tells when the last sample is written (or the drain time is up).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 from enum import Enum
 
 from haptic_msgs_py.stamps import NS_PER_S
+from haptic_msgs_py.topics import PROGRESS_NOT_MATCHED_NS
 
 RECORDER_STALE_S = 1.0  # a recorder silent this long no longer holds the loop
 DRAIN_TIMEOUT_S = 10.0  # how long a finished run waits for a recorder to write its last sample
@@ -37,12 +40,22 @@ class RecorderGate:
         self.held: list[float] | None = None  # a command waiting for the recorder
         self.drain_until: float | None = None  # monotonic s; set once the last sample went out
         self._reports: dict[str, tuple[float, int]] = {}  # name -> (monotonic s, stamp ns)
+        self._matched: set[str] = set()  # recorders whose readers have matched their writers
 
     def report(self, name: str, stamp_ns: int, now: float) -> None:
-        """Recorder ``name`` has written up to ``stamp_ns`` (reported at monotonic ``now``, s)."""
+        """Recorder ``name`` has written up to ``stamp_ns`` (reported at monotonic ``now``, s),
+        or has not matched yet (``PROGRESS_NOT_MATCHED_NS``)."""
+        if stamp_ns <= PROGRESS_NOT_MATCHED_NS:
+            self._matched.discard(name)
+            return
+        self._matched.add(name)
         reports = self._reports
         reports[name] = (now, stamp_ns)
         self.written_ns = min(ns for t, ns in reports.values() if t >= now - self.stale_s)
+
+    def unmatched(self, recorders: int) -> bool:
+        """Fewer recorders have said they matched than the ``recorders`` the graph shows."""
+        return len(self._matched) < recorders
 
     def lags(self, sample_ns: int, max_lag_s: float) -> bool:
         """A recorder reports and is more than ``max_lag_s`` (s) behind the sample's stamp."""

@@ -1,10 +1,10 @@
 """recorder_node: record a session into a rosbag2 (MCAP or sqlite3) with the ``rosbags`` writer.
 
-- Subscribes raw (serialized CDR) to each topic and writes the bytes as they are: reliable,
-  transient-local ``qos.RECORD`` for the loop's topics (a late match still gets the publishers'
-  last 2000 samples), the parameter-events profile for
-  ``/parameter_events``, reliable volatile for other topics. Bag time is the receive time (wall
-  clock, ns); the analysis times samples by their header stamps.
+- Subscribes raw (serialized CDR) to each topic and writes the bytes as they are: reliable
+  ``qos.RECORD`` for the loop's topics (a recorder that falls behind is repaired from the
+  publishers' last 2000 samples), the parameter-events profile for ``/parameter_events``,
+  reliable volatile for other topics. Bag time is the receive time (wall clock, ns); the
+  analysis times samples by their header stamps.
 - Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``;
   a node silent for ``snapshot_timeout_s`` is warned about and still asked) as a
   ``rcl_interfaces/msg/ParameterEvent`` with all parameters in ``new_parameters``, on
@@ -16,7 +16,9 @@
   flowing (header stamps; the effort command's ``effort@<stamp>`` label). A lockstep device
   holds the loop while that lags, so a recorded lockstep run loses nothing. The report is held
   where a node appeared until its parameters came (at most ``snapshot_timeout_s``), so a short
-  lockstep run cannot end before the bag knows the session's parameters.
+  lockstep run cannot end before the bag knows the session's parameters. Before the first loop
+  sample it reports ``PROGRESS_NOT_MATCHED_NS`` while a reader has not matched its writers
+  (``haptic_dob.recorder.matching``): the device sends sample 0 only after that.
 - On SIGINT/SIGTERM (or after ``duration_s``) it takes what is still queued (at most
   ``drain_timeout_s``, until nothing arrives for 0.1 s), then closes the bag so it is readable,
   and reports per topic what it received, wrote and which stamps are missing (gaps).
@@ -28,7 +30,7 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from rcl_interfaces.srv import GetParameters, ListParameters
@@ -46,6 +48,7 @@ from std_msgs.msg import Header
 
 from haptic_dob.nodes.common import main_for
 from haptic_dob.recorder.drain import take_until_quiet
+from haptic_dob.recorder.matching import ReaderMatch, reported_progress
 from haptic_dob.recorder.recording import Recording
 from haptic_dob.recorder.settings import new_bag_path, recorder_specs
 from haptic_dob.recorder.snapshots import ParameterSnapshot, SnapshotTracker
@@ -124,8 +127,16 @@ class RecorderNode(LoopNode):
 
     def reported_progress_ns(self) -> int:
         """``progress_ns``, held where a node appeared while its parameters are still asked for
-        (at most ``snapshot_timeout_s``): a lockstep run waits for what the bag must know."""
-        return self.snapshots.held_ns(self.progress_ns())
+        (at most ``snapshot_timeout_s``): a lockstep run waits for what the bag must know.
+        Before the loop starts, ``PROGRESS_NOT_MATCHED_NS`` while a reader has not matched."""
+        held = self.snapshots.held_ns(self.progress_ns())
+        return reported_progress(held, self.recording.counts, self._reader_matches())
+
+    def _reader_matches(self) -> Iterator[ReaderMatch]:
+        for sub, _ in self._subs:
+            yield ReaderMatch(
+                sub.topic_name, sub.get_publisher_count(), self.count_publishers(sub.topic_name)
+            )
 
     def _publish_progress(self) -> None:
         if self.recording.closed:

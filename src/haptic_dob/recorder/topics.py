@@ -19,7 +19,7 @@ class TopicKind(Enum):
     """Which subscription a recorded topic gets."""
 
     EVENTS = "events"  # /parameter_events: the parameter-events profile
-    SESSION = "session"  # a loop topic: reliable, transient local (a late match gets history)
+    SESSION = "session"  # a loop topic: reliable, deep queue (repaired from the writers' history)
     OTHER = "other"  # reliable, volatile
 
 

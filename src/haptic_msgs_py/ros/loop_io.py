@@ -6,11 +6,10 @@ nodes (composed), a topic goes on DDS only while a reader elsewhere is matched: 
 the publisher's matched events, and a lockstep device waits for every publisher of its process to
 have matched the readers the graph shows before sample 0 (a reader that matches while the loop
 runs gets the samples from when this process has seen the match, a few milliseconds later). A
-node alone in its process sends always, as any ROS 2 publisher does (late readers get its
-transient-local history), except ``on_demand`` topics (evaluation only), sent while a reader is
-matched. ``LoopSubscription`` takes values
-from publishers in this process and opens a DDS subscription only while the topic has none here,
-so a composed node never also receives its neighbour's message over DDS. Every node keeps its
+node alone in its process sends always, as any ROS 2 publisher does, except ``on_demand`` topics
+(evaluation only), sent while a reader is matched. ``LoopSubscription`` takes values from
+publishers in this process and opens a DDS subscription only while the topic has none here, so a
+composed node never also receives its neighbour's message over DDS. Every node keeps its
 ordinary rclpy publishers, so ``ros2 topic list``/``info``/``echo`` see the same graph whether
 nodes share a process or not.
 """

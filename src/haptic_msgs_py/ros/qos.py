@@ -1,14 +1,13 @@
 """QoS profiles of the haptic loop.
 
-Loop publishers are reliable and transient-local and keep the last 2000 samples: a recorder
-(which must not lose a sample) subscribing reliable + transient-local gets every sample even when
-its subscription matched a publisher late after start-up (endpoint matching between processes
-takes a moment, and a reader can match a writer some time after the writer matched it) or fell
-behind, by up to 2000 samples (2 s at 1 kHz). The price: a late reader that asks for the
-publisher's durability (``ros2 topic echo`` adapts to it) is first sent that history. Volatile
-publishers would spare it, but then a recorder whose reader matched a writer after that writer
-had matched it (and sent) loses those samples; the device's start gate sees only its own side of
-a match, so that needs a handshake from the reader first.
+Loop publishers are reliable and volatile and keep the last 2000 samples: a reliable reader that
+falls behind (a recorder on a loaded machine) is repaired from that history, by up to 2000
+samples (2 s at 1 kHz), and a reader that joins late (``ros2 topic echo``, a plot, RViz) sees the
+live stream at once, not a replay. A reader gets only what is sent after it has matched the
+writer, and it can match some time after the writer matched it; so a reader that must have every
+sample from the first (the recorder) is matched on both sides before sample 0: the device waits
+for its writers to match every subscriber the graph shows, and for every recorder to report that
+its readers have matched (``recorder/progress``, ``PROGRESS_NOT_MATCHED_NS`` until then).
 
 The loop's own subscriptions (``loop_input``, a node's ``input_reliability``) have a deep queue.
 The command input (the device's ``effort_command``) is reliable by default: a person's one-off
@@ -38,7 +37,7 @@ LOOP = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=LOOP_HISTORY,
     reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    durability=DurabilityPolicy.VOLATILE,
 )
 
 LOOP_IN = QoSProfile(
@@ -78,5 +77,5 @@ RECORD = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=LOOP_HISTORY,
     reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    durability=DurabilityPolicy.VOLATILE,
 )

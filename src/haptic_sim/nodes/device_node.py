@@ -95,10 +95,10 @@ class DeviceNode(LoopNode):
         inputs = qos.loop_input(v["input_reliability"])
         self._sub = LoopSubscription(self, EFFORT_COMMAND, codecs.EFFORT, self.loop.command, inputs)
         self._bus = self._sub.bus
-        if self.lockstep:
-            raw_subscription(
-                self, "std_msgs/msg/Header", RECORDER_PROGRESS, self._on_progress, qos.CLOCK
-            )
+        # both modes: sample 0 waits for the recorders' readers to match; lockstep back-pressure
+        raw_subscription(
+            self, "std_msgs/msg/Header", RECORDER_PROGRESS, self._on_progress, qos.CLOCK
+        )
         self.diagnostics = Diagnostics(self, self._report)
         mode = "lockstep" if self.lockstep else f"realtime at {v['rate_hz']:g} Hz"
         self.get_logger().info(
