@@ -42,7 +42,7 @@ bench: $(STAMP)
 # Re-resolve the dependency set and rewrite constraints.txt (review the diff).
 lock:
 	@$(PYTHON) -m venv /tmp/haptic-dob-lock && /tmp/haptic-dob-lock/bin/pip install -qq \
-		--dry-run --ignore-installed --report /tmp/haptic-dob-lock.json -e '.[dev]'
+		--dry-run --ignore-installed --report /tmp/haptic-dob-lock.json -e '.[dev,arms]'
 	@$(PYTHON) scripts/write_constraints.py /tmp/haptic-dob-lock.json constraints.txt
 
 clean:

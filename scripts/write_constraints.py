@@ -5,7 +5,8 @@ from __future__ import annotations
 import json
 import sys
 
-HEADER = """# Exact versions of every distribution `make install` resolves (pip constraints file).
+HEADER = """# Exact versions of every distribution `make install` resolves, and of the optional
+# `arms` extra (pip constraints file).
 # Regenerate after changing dependencies with `make lock` and review the diff.
 """
 

@@ -151,14 +151,6 @@ def test_urdf_model_errors_are_clear(args, message: str) -> None:
         UrdfModel(*args)
 
 
-def test_continuous_joints_are_refused_with_a_reason() -> None:
-    xml = ARM3.read_text().replace(
-        'name="joint3" type="revolute"', 'name="joint3" type="continuous"'
-    )
-    with pytest.raises(ValueError, match=r"joint3 .*not a 1-DOF revolute or prismatic"):
-        UrdfModel(xml, "tool")
-
-
 def test_factory_builds_urdf_and_phantom_models_from_parameters() -> None:
     names = {s.name for s in model_specs()}
     assert {"robot_description", "urdf_path", "tip_frame", "joint_names", "urdf.gravity"} <= names

@@ -8,17 +8,16 @@ angles (the PHANToM's parallelogram) be computed on its open tree::
 
     D = S^T M_t(S q) S,   C q' + G = S^T rnea(S q, S q', 0),   J = J_t(S q) S
 
-Two builders make the pinocchio models: ``tree_model`` (a tree of revolute joints with point-like
-bodies, declared with ``TreeJoint`` rows) and ``urdf_model`` (a URDF string or file, reduced to
-the chosen joints). SI units throughout; gravity is 9.81 m/s^2 along -z.
+A model whose configuration is not its joint angles (continuous joints: ``(cos, sin)``) takes our
+angles through ``pinocchio.integrate`` from its neutral configuration. ``tree_model`` builds a tree
+of revolute joints with point-like bodies (``TreeJoint`` rows); URDF arms come from
+``_pinocchio_urdf``. SI units throughout; gravity is 9.81 m/s^2 along -z.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -88,83 +87,6 @@ def tree_model(
     return model, fid
 
 
-@dataclass(frozen=True)
-class UrdfArm:
-    """A URDF arm reduced to its chosen joints (what ``urdf_model`` returns)."""
-
-    model: pin.Model
-    frame_id: int
-    joint_names: tuple[str, ...]  # the DeviceModel's joint order
-    S: np.ndarray | None  # pinocchio velocity order from ours (a permutation), None = same
-    effort_limits: tuple[float, ...]  # from the URDF's <limit effort>, N m or N (0 = none)
-
-
-def read_urdf(urdf: str | Path) -> str:
-    """The URDF XML: ``urdf`` itself when it is XML text, else the file it names."""
-    text = str(urdf)
-    if text.lstrip().startswith("<"):
-        return text
-    path = Path(text).expanduser()
-    if not path.is_file():
-        raise ValueError(f"urdf: no such file {text!r} (and not URDF XML text)")
-    return path.read_text(encoding="utf-8")
-
-
-def urdf_model(
-    urdf: str | Path, tip_frame: str, joint_names: Sequence[str] | None = None
-) -> UrdfArm:
-    """Parse a URDF (string or path) and keep ``joint_names`` (default: the chain to the tip).
-
-    Every other joint is locked at its neutral position. Revolute, prismatic and continuous
-    joints are accepted (a continuous joint is used through its angle). Raises ``ValueError``
-    with a clear message for a bad URDF, an unknown tip frame or joint, or a joint type the
-    model cannot use.
-    """
-    xml = read_urdf(urdf)
-    try:
-        full = pin.buildModelFromXML(xml)
-    except (RuntimeError, ValueError) as exc:
-        raise ValueError(f"urdf: cannot parse the URDF: {exc}") from None
-    if not full.existFrame(tip_frame):
-        names = ", ".join(f.name for f in full.frames if f.name != "universe")
-        raise ValueError(f"tip_frame {tip_frame!r} is not a frame of the URDF (it has: {names})")
-    tip_parent = full.frames[full.getFrameId(tip_frame)].parentJoint
-    movable = [full.names[i] for i in range(1, full.njoints)]
-    if joint_names:
-        wanted = [str(n) for n in joint_names]
-        unknown = [n for n in wanted if n not in movable]
-        if unknown:
-            raise ValueError(
-                f"joint_names: {', '.join(unknown)} not movable joints of the URDF "
-                f"(it has: {', '.join(movable)})"
-            )
-        if len(set(wanted)) != len(wanted):
-            raise ValueError(f"joint_names lists a joint twice: {wanted}")
-    else:
-        wanted = [full.names[i] for i in full.supports[tip_parent] if i != 0]
-        if not wanted:
-            raise ValueError(f"tip_frame {tip_frame!r} is not moved by any joint")
-    lock = [i for i in range(1, full.njoints) if full.names[i] not in wanted]
-    model = pin.buildReducedModel(full, lock, pin.neutral(full)) if lock else full
-    for i in range(1, model.njoints):
-        jm = model.joints[i]
-        if jm.nv != 1 or jm.nq != 1:
-            raise ValueError(
-                f"joint {model.names[i]} ({jm.shortname()}) is not a 1-DOF revolute or prismatic "
-                "joint; continuous and multi-DOF joints are not supported"
-            )
-    order = [model.names[i] for i in range(1, model.njoints)]
-    idx = [order.index(n) for n in wanted]
-    S = None
-    if idx != list(range(len(idx))):
-        S = np.zeros((len(idx), len(idx)))
-        for ours, theirs in enumerate(idx):
-            S[theirs, ours] = 1.0
-    limits = tuple(float(model.effortLimit[model.joints[order.index(n) + 1].idx_v]) for n in wanted)
-    limits = tuple(v if math.isfinite(v) and v > 0.0 else 0.0 for v in limits)
-    return UrdfArm(model, model.getFrameId(tip_frame), tuple(wanted), S, limits)
-
-
 # --- the device model on a pinocchio model -----------------------------------------------------
 class PinocchioModel(DeviceModel):
     """A ``DeviceModel`` computed by pinocchio on ``model`` (one ``Data``, built here).
@@ -207,6 +129,9 @@ class PinocchioModel(DeviceModel):
         # S^T (unused without a selection: empty, so the type stays an array)
         self._St: Mat = np.empty((0, 0)) if S is None else np.ascontiguousarray(S.T)
         self._zero_t = np.zeros(model.nv)
+        # continuous joints: pinocchio's configuration is (cos, sin), ours the angle
+        self._angles_to_config = model.nq != model.nv
+        self._neutral = pin.neutral(model)
         visc = np.asarray(viscous, dtype=np.float64)
         visc = (
             np.full(self.dof, float(visc)) if visc.ndim == 0 else vector("viscous", visc, self.dof)
@@ -216,45 +141,58 @@ class PinocchioModel(DeviceModel):
         self.viscous = visc
         self._has_friction = bool(np.any(visc > 0.0))
 
+    # --- our coordinates to pinocchio's ------------------------------------------------------
+    def _conf(self, q: Vec) -> Vec:
+        """Pinocchio's configuration for our joint coordinates ``q`` (angles, offsets)."""
+        qt = q if self._S is None else self._S @ q
+        if self._angles_to_config:
+            conf: Vec = pin.integrate(self._model, self._neutral, qt)
+            return conf
+        return qt
+
+    def _vel(self, qd: Vec) -> Vec:
+        """Pinocchio's velocity for ours."""
+        return qd if self._S is None else self._S @ qd
+
+    def _ours(self, M: Mat) -> Mat:
+        """A (nv, nv) matrix of pinocchio's in our coordinates (``S^T M S``), copied."""
+        return M.copy() if self._S is None else self._St @ M @ self._S
+
+    def _effort(self, tau: Vec) -> Vec:
+        """A generalized force of pinocchio's in our coordinates (``S^T tau``), copied."""
+        return tau.copy() if self._S is None else self._St @ tau
+
+    def _columns(self, J: Mat) -> Mat:
+        """A Jacobian over pinocchio's velocity in our coordinates (``J S``), copied."""
+        return J.copy() if self._S is None else J @ self._S
+
     # --- one pass for the observer and the simulator -------------------------------------------
     def mass_and_bias(self, q: Vec, qd: Vec) -> tuple[Mat, Vec]:
         """D(q) and C(q, q') q' + G(q) + friction(q') from one pinocchio pass (validated)."""
         return self._mass_and_bias(self._q(q), self._qd(qd))
 
     def _mass_and_bias(self, q: Vec, qd: Vec) -> tuple[Mat, Vec]:
-        m, d, S = self._model, self._data, self._S
-        if S is None:
-            D = pin.crba(m, d, q).copy()
-            h = pin.rnea(m, d, q, qd, self._zero_t).copy()
-        else:
-            qt = S @ q
-            D = self._St @ pin.crba(m, d, qt) @ S
-            h = self._St @ pin.rnea(m, d, qt, S @ qd, self._zero_t)
+        m, d = self._model, self._data
+        qt = self._conf(q)
+        D = self._ours(pin.crba(m, d, qt))
+        h = self._effort(pin.rnea(m, d, qt, self._vel(qd), self._zero_t))
         if self._has_friction:
             h += self.viscous * qd
         return D, h
 
     # --- DeviceModel ---------------------------------------------------------------------------
     def _mass_matrix(self, q: Vec) -> Mat:
-        m, d, S = self._model, self._data, self._S
-        M: Mat = pin.crba(m, d, q if S is None else S @ q)
-        return M.copy() if S is None else self._St @ M @ S
+        return self._ours(pin.crba(self._model, self._data, self._conf(q)))
 
     def _rnea(self, q: Vec, qd: Vec) -> Vec:
-        m, d, S = self._model, self._data, self._S
-        if S is None:
-            h: Vec = pin.rnea(m, d, q, qd, self._zero_t)
-            return h.copy()
-        hs: Vec = pin.rnea(m, d, S @ q, S @ qd, self._zero_t)
-        return self._St @ hs
+        m, d = self._model, self._data
+        return self._effort(pin.rnea(m, d, self._conf(q), self._vel(qd), self._zero_t))
 
     def _coriolis_vector(self, q: Vec, qd: Vec) -> Vec:
         return self._rnea(q, qd) - self._gravity(q)
 
     def _gravity(self, q: Vec) -> Vec:
-        m, d, S = self._model, self._data, self._S
-        g: Vec = pin.computeGeneralizedGravity(m, d, q if S is None else S @ q)
-        return g.copy() if S is None else self._St @ g
+        return self._effort(pin.computeGeneralizedGravity(self._model, self._data, self._conf(q)))
 
     def _friction(self, qd: Vec) -> Vec:
         return self.viscous * qd
@@ -266,13 +204,13 @@ class PinocchioModel(DeviceModel):
         return h
 
     def _jacobian(self, q: Vec) -> Mat:
-        m, d, S = self._model, self._data, self._S
-        J: Mat = pin.computeFrameJacobian(m, d, q if S is None else S @ q, self._fid, _LWA)[:3]
-        return J.copy() if S is None else J @ S
+        m, d = self._model, self._data
+        J: Mat = pin.computeFrameJacobian(m, d, self._conf(q), self._fid, _LWA)[:3]
+        return self._columns(J)
 
     def _forward_kinematics(self, q: Vec) -> Vec:
-        m, d, S = self._model, self._data, self._S
-        pin.forwardKinematics(m, d, q if S is None else S @ q)
+        m, d = self._model, self._data
+        pin.forwardKinematics(m, d, self._conf(q))
         x: Vec = pin.updateFramePlacement(m, d, self._fid).translation.copy()
         return x
 
@@ -282,14 +220,13 @@ class PinocchioModel(DeviceModel):
         ``J' q'`` is the point's acceleration at zero joint acceleration (the classical
         acceleration, centripetal terms included): what a point mass at the tip adds to the bias.
         """
-        m, d, S = self._model, self._data, self._S
-        qt, vt = (q, qd) if S is None else (S @ q, S @ qd)
-        pin.forwardKinematics(m, d, qt, vt, self._zero_t)
+        m, d = self._model, self._data
+        qt = self._conf(q)
+        pin.forwardKinematics(m, d, qt, self._vel(qd), self._zero_t)
         p = pin.updateFramePlacement(m, d, self._fid).translation.copy()
         acc = pin.getFrameClassicalAcceleration(m, d, self._fid, _LWA).linear.copy()
         pin.computeJointJacobians(m, d, qt)
-        Jt = pin.getFrameJacobian(m, d, self._fid, _LWA)[:3]
-        return p, (Jt.copy() if S is None else Jt @ S), acc
+        return p, self._columns(pin.getFrameJacobian(m, d, self._fid, _LWA)[:3]), acc
 
     def _dynamics_and_tip(self, q: Vec, qd: Vec) -> tuple[Mat, Vec, Vec, Mat, Vec]:
         """D, bias effort, end-effector point, its Jacobian and ``J' q'`` from one pass.
@@ -297,23 +234,17 @@ class PinocchioModel(DeviceModel):
         One ``computeAllTerms`` (what the simulator needs at every integration stage when forces
         act at the tip).
         """
-        m, d, S = self._model, self._data, self._S
-        qt, vt = (q, qd) if S is None else (S @ q, S @ qd)
-        pin.computeAllTerms(m, d, qt, vt)
-        fid = self._fid
-        Jt = pin.getFrameJacobian(m, d, fid, _LWA)[:3]
+        m, d, fid = self._model, self._data, self._fid
+        pin.computeAllTerms(m, d, self._conf(q), self._vel(qd))
+        J = self._columns(pin.getFrameJacobian(m, d, fid, _LWA)[:3])
         p = pin.updateFramePlacement(m, d, fid).translation.copy()
         acc = pin.getFrameClassicalAcceleration(m, d, fid, _LWA).linear.copy()
-        if S is None:
-            D, h, J = d.M.copy(), d.nle.copy(), Jt.copy()
-        else:
-            D, h, J = self._St @ d.M @ S, self._St @ d.nle, Jt @ S
+        D, h = self._ours(d.M), self._effort(d.nle)
         if self._has_friction:
             h += self.viscous * qd
         return D, h, p, J, acc
 
     def potential_energy(self, q: Vec) -> float:
         """Gravitational potential energy (J) of the device at ``q`` (0 without gravity)."""
-        m, d, S = self._model, self._data, self._S
-        q_ = self._q(q)
-        return float(pin.computePotentialEnergy(m, d, q_ if S is None else S @ q_))
+        m, d = self._model, self._data
+        return float(pin.computePotentialEnergy(m, d, self._conf(self._q(q))))

@@ -1,9 +1,12 @@
 """Any serial arm from a URDF, computed with pinocchio (sensorless tip-force estimation).
 
 The joint-space vectors follow ``joint_names`` (default: the joints that move ``tip_frame``, from
-the root out); every other joint of the URDF is locked at zero. The end-effector point is the
-origin of ``tip_frame``; its Jacobian is the linear part of the frame Jacobian in the base frame's
-axes (pinocchio's ``LOCAL_WORLD_ALIGNED``). Gravity is 9.81 m/s^2 along -z of the URDF's root.
+the root out); every other joint of the URDF is locked at zero. Revolute, continuous (used through
+its angle) and prismatic joints can be coordinates; mimic joints follow their master; fixed joints,
+grippers outside the chain and meshes need nothing (see ``_pinocchio_urdf``). The end-effector
+point is the origin of ``tip_frame``; its Jacobian is the linear part of the frame Jacobian in the
+base frame's axes (pinocchio's ``LOCAL_WORLD_ALIGNED``). Gravity is 9.81 m/s^2 along -z of the
+URDF's root.
 """
 
 from __future__ import annotations
@@ -12,7 +15,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from haptic_dob.models._pinocchio import PinocchioModel, urdf_model
+from haptic_dob.models._pinocchio import PinocchioModel
+from haptic_dob.models._pinocchio_urdf import urdf_model
 from haptic_dob.runtime.params import param
 
 
@@ -27,7 +31,7 @@ class UrdfModel(PinocchioModel):
         viscous: viscous joint friction (N m s/rad or N s/m), scalar or per joint, default 0.
 
     Raises ``ValueError`` with a clear message for a bad URDF, an unknown frame or joint, or a
-    joint that is not a 1-DOF revolute or prismatic joint.
+    joint that cannot be a coordinate (floating, planar, a mimic joint named in ``joint_names``).
     """
 
     def __init__(
