@@ -102,7 +102,7 @@ def test_the_batch_cycle_is_the_three_stages_in_order() -> None:
     )
     observer = DisturbanceObserver(model, 41.6, 1e-3, 4.0)
     controller = ImpedanceController(model, law)
-    device = SimulatedSlide(cfg.model, cfg.device, cfg.sensor, cfg.hand, 1000.0, 10, 0)
+    device = SimulatedSlide(cfg.device, cfg.sensor, cfg.hand, 1000.0, 10, 0)
     for _ in range(2000):
         s = device.sample()
         got = cycle.step(

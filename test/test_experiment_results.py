@@ -59,7 +59,7 @@ def _every_part() -> dict[str, object]:
             [dob.FirstVibrating(2.0, 0.24, dob.first_vibrating(kick, 2.0, 0.24))],
             [dob.LinearOnset(100.0, 2.0, 0.0, None)],
             [dob.GainBandwidth(2.0, 1.0, 800.0, None, 48.0)],
-            [dob.MismatchCell(800.0, 25.0, m, 3.0, 30.0) for m in ("exact", "no Coulomb")],
+            [dob.MismatchCell(800.0, 25.0, m, 3.0, 30.0) for m in ("assumed", "no Coulomb")],
         ),
         "phantom": PhantomResult(
             [0.0, 0.012, 0.004], [0.0, 0.95, 0.49], [PhantomWallCell(1.0, 0.3, 8e-5, 0.008)]

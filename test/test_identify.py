@@ -23,7 +23,7 @@ from haptic_dob.models.slide import SlideParams
 from haptic_dob.runtime.params import load_node_params
 from haptic_msgs_py import wire
 from haptic_sim.hand import HandParams
-from haptic_sim.slide import SimulatedSlide
+from haptic_sim.slide import SimulatedSlide, SlideDeviceParams
 
 TRUTH = SlideParams()  # m 0.416 kg, c 1.272 N s/m, Fc 0.24 N
 
@@ -32,7 +32,7 @@ def simulate(
     excite: Callable[[float], float], seconds: float, physics: SlideParams = TRUTH
 ) -> JointRecord:
     """The slide under ``excite(t)`` (N) plus an 80 N/m spring on the encoder position."""
-    slide = SimulatedSlide(physics=physics, hand=HandParams(behaviour="none"))
+    slide = SimulatedSlide(SlideDeviceParams.matching(physics), hand=HandParams(behaviour="none"))
     stamps, pos, eff = [], [], []
     for k in range(round(seconds * 1000)):
         s = slide.sample()

@@ -29,16 +29,28 @@ def test_dob_kf_100_is_unstable_at_any_stiffness_with_the_default_observer() -> 
 
 @pytest.mark.parametrize(("mode", "kf"), [("CL", 2.0), ("DOB", 1.0), ("DOB", 2.0)])
 def test_the_model_matches_the_simulated_onset(mode: str, kf: float) -> None:
-    """The protocol's batch onset (encoder, sensor noise, no Coulomb, the 20 N/m grip) is the
-    linear model's with the same grip, within 3 %; the grip matters (DOB Kf=1: 775 -> 661 N/m)."""
+    """The protocol's batch onset (encoder, sensor noise, no Coulomb, the 20 N/m grip, the
+    amplifier lag) is the linear model's with the same grip and lag, within 3 %; the grip
+    matters (DOB Kf=1: 775 -> 661 N/m), and so does the lag (661 -> 589 N/m)."""
     from haptic_sim.session import SessionConfig
     from haptic_sim.stability import StabilityProtocol, law_for, sweep
 
     grip = StabilityProtocol().grip_n_per_m
-    lin = linear_onset(kf, mode, hand_stiffness=grip)
+    lag = SessionConfig().device.amplifier_lag_s
+    lin = linear_onset(kf, mode, hand_stiffness=grip, amplifier_lag_s=lag)
     base = SessionConfig().replace(law=law_for(mode, kf))
     result = sweep([lin * 0.9, lin * 0.97, lin * 1.03, lin * 1.1], base)
     assert result.onset_stiffness_n_per_m == pytest.approx(lin, rel=0.03)
+
+
+@pytest.mark.parametrize(("mode", "kf"), [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0)])
+def test_a_vanishing_amplifier_lag_is_no_lag_and_a_lag_lowers_the_onset(mode, kf) -> None:
+    none = linear_onset(kf, mode, hand_stiffness=20.0)
+    assert linear_onset(kf, mode, hand_stiffness=20.0, amplifier_lag_s=1e-9) == pytest.approx(
+        none, abs=1.0
+    )
+    lags = [linear_onset(kf, mode, hand_stiffness=20.0, amplifier_lag_s=t) for t in (5e-5, 2e-4)]
+    assert none > lags[0] > lags[1]
 
 
 def test_bad_arguments() -> None:

@@ -32,7 +32,9 @@ def constant_force_run(gain: float, force_n: float = 1.0, t_on: float = 0.1, dri
         perturbation_s=1e3,
     )
     # a fine encoder: the test is about the observer, not about quantization noise
-    dev = SimulatedSlide(SlideParams(), SlideDeviceParams(encoder_resolution_m=1e-12), hand=hand)
+    dev = SimulatedSlide(
+        SlideDeviceParams.matching(SlideParams(), encoder_resolution_m=1e-12), hand=hand
+    )
     obs = DisturbanceObserver(dev.model, gain, dev.dt)
     tau = dev.model.mass_kg / gain
     n = round((t_on + 5 * tau) / dev.dt)

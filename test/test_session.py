@@ -44,19 +44,28 @@ def test_yaml_config_is_the_default_session(root) -> None:
     assert cfg == SessionConfig()
 
 
-def test_node_params_with_a_mismatched_observer_model() -> None:
+def test_node_params_take_the_plant_from_the_device_and_the_model_from_the_observer() -> None:
     cfg = SessionConfig.from_node_params(
         {
-            "/**": {"slide.mass_kg": 0.5, "rate_hz": 500.0},
-            "observer_node": {"slide.mass_kg": 0.45, "gain": 20.0},
+            "/**": {"slide.mass_kg": 0.45, "rate_hz": 500.0},
+            "device_node": {"plant.mass_kg": 0.5, "plant.amplifier_lag_s": 0.0},
+            "observer_node": {"gain": 20.0},
             "controller_node": {"mode": "DOB", "kf": 1},
             "environment_node": {"stiffness_n_per_m": 1600},
         }
     )
-    assert cfg.model.mass_kg == 0.5 and cfg.observer_model.mass_kg == 0.45
+    assert cfg.device.mass_kg == 0.5 and cfg.device.amplifier_lag_s == 0.0
+    assert cfg.model.mass_kg == 0.45
     assert cfg.loop.rate_hz == 500.0 and cfg.observer.gain == 20.0
     assert cfg.law.mode.value == "DOB" and cfg.law.kf == 1.0
     assert cfg.wall.stiffness_n_per_m == 1600.0
+
+
+def test_observer_and_controller_must_assume_one_model() -> None:
+    with pytest.raises(ValueError, match="assume different slide models"):
+        SessionConfig.from_node_params(
+            {"observer_node": {"slide.mass_kg": 0.45}, "controller_node": {"slide.mass_kg": 0.5}}
+        )
 
 
 @pytest.mark.parametrize(

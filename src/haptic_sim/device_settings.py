@@ -21,6 +21,10 @@ from haptic_sim.factory import simulation_specs
 DEFAULT_WAIT_FOR = ["environment_node", "observer_node", "controller_node"]
 
 
+#: model parameters a simulated device does not take (its own physics are ``plant.*``)
+ASSUMED_ONLY = frozenset({"slide.mass_kg", "slide.viscous_n_s_per_m", "slide.coulomb_n"})
+
+
 def device_node_specs() -> list[ParamSpec]:
     """Every parameter of the device node."""
     return [
@@ -28,7 +32,8 @@ def device_node_specs() -> list[ParamSpec]:
         *loop_specs(),
         *input_specs("reliable"),
         *process_specs(),
-        *model_specs(),
+        # the slide's physics is plant.* (its truth); slide.* is the model the others assume
+        *(s for s in model_specs() if s.name not in ASSUMED_ONLY),
         ParamSpec(
             "clock_mode",
             "lockstep",

@@ -1,6 +1,7 @@
 """Build a simulated device from parameters: the device node and batch runs share it.
 
-``model: slide`` builds the ``SimulatedSlide`` (groups ``slide.``, ``plant.``); ``model: phantom``
+``model: slide`` builds the ``SimulatedSlide`` (its physics ``plant.``, its axis ``slide.axis``; the
+model an observer assumes, ``slide.*``, is not the plant's truth); ``model: phantom``
 or ``urdf`` a ``SimulatedArm`` of the model ``build_model`` names (groups ``phantom.`` or the URDF
 parameters, and ``arm.``). ``sensor.`` and ``hand.`` serve both.
 """
@@ -37,11 +38,11 @@ def build_device(values: Mapping[str, Any]) -> SimulatedSlide | SimulatedArm:
     loop = build(LoopSettings, values)
     if kind == "slide":
         return SimulatedSlide(
-            build(SlideParams, values, "slide."),
             build(SlideDeviceParams, values, "plant."),
             build(ForceSensorParams, values, "sensor."),
             build(HandParams, values, "hand."),
             *loop.device_args(),
+            axis=build(SlideParams, values, "slide.").axis,
         )
     if kind in ("phantom", "urdf"):
         return SimulatedArm(

@@ -73,8 +73,9 @@ class LoopSettings:
 class SessionConfig:
     """Everything a simulated slide session needs (each part is a parameter group of a node).
 
-    ``model`` is the slide's true physics (device node) and, unless ``observer_model`` is given,
-    also the observer's model (a perfect model).
+    ``device`` is the simulated slide, its true physics included (the device node's ``plant.*``);
+    ``model`` is what the observer and the controller assume (their ``slide.*``: the identified
+    model, never the plant's truth unless a config makes it so); the slide's axis is the model's.
     """
 
     loop: LoopSettings = field(default_factory=LoopSettings)
@@ -86,7 +87,6 @@ class SessionConfig:
     law: ImpedanceLaw = field(default_factory=ImpedanceLaw)
     # the thesis clipped the slide's estimate to the actuator's 4 N
     observer: ObserverSettings = field(default_factory=lambda: ObserverSettings(output_limit=4.0))
-    observer_model: SlideParams | None = None
 
     def replace(self, **groups: Any) -> SessionConfig:
         """A copy with whole groups replaced, or single fields as ``group__field=value``."""
@@ -97,15 +97,20 @@ class SessionConfig:
     def from_node_params(cls, nodes: Mapping[str, Mapping[str, Any]]) -> SessionConfig:
         """Build from per-node parameter dicts (``device_node``, ``environment_node``, ...).
 
-        Keys follow the nodes' parameter names (``slide.mass_kg``, ``hand.offset_m``,
-        ``stiffness_n_per_m``, ``mode``, ``gain``...); ``/**`` applies to every node.
+        Keys follow the nodes' parameter names (``plant.mass_kg``, ``slide.mass_kg``,
+        ``hand.offset_m``, ``stiffness_n_per_m``, ``mode``, ``gain``...); ``/**`` applies to every
+        node. The assumed model is the observer's (the controller's must be the same).
         """
         dev, env, obs, ctl = (
             node_view(nodes, n)
             for n in ("device_node", "environment_node", "observer_node", "controller_node")
         )
-        model = build(SlideParams, dev, "slide.")
-        obs_model = build(SlideParams, obs, "slide.")
+        model = build(SlideParams, obs, "slide.")
+        if build(SlideParams, ctl, "slide.") != model:
+            raise ValueError(
+                "the observer and the controller assume different slide models (slide.*): "
+                "a batch session runs one"
+            )
         return cls(
             loop=build(LoopSettings, dev),
             model=model,
@@ -115,7 +120,6 @@ class SessionConfig:
             wall=build(VirtualWall, env),
             law=build(ImpedanceLaw, ctl),
             observer=build(ObserverSettings, obs),
-            observer_model=None if obs_model == model else obs_model,
         )
 
     @classmethod
@@ -204,13 +208,13 @@ def run_session(config: SessionConfig, cycles: int | None = None) -> SessionResu
     """Run ``config`` in-process for ``cycles`` cycles (default: duration_s * rate_hz)."""
     loop = config.loop
     device = SimulatedSlide(
-        config.model, config.device, config.sensor, config.hand, *loop.device_args()
+        config.device, config.sensor, config.hand, *loop.device_args(), axis=config.model.axis
     )
     n = loop.batch_cycles(cycles)
-    obs_model = (config.observer_model or config.model).model()
-    observer = config.observer.build(obs_model, device.dt)
+    model = config.model.model()
+    observer = config.observer.build(model, device.dt)
     cycle = LoopCycle(
-        config.wall, observer, ImpedanceController(obs_model, config.law), device.period_ns
+        config.wall, observer, ImpedanceController(model, config.law), device.period_ns
     )
     axis = device.model.axis
     ax0, ax1, ax2 = (float(a) for a in axis)

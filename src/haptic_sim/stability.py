@@ -79,19 +79,11 @@ class StabilityProtocol:
             perturbation_at_s=self.pulse_at_s,
             perturbation_s=self.pulse_s,
         )
-        model = base.model.__class__(
-            base.model.mass_kg, base.model.viscous_n_s_per_m, self.coulomb_n, base.model.axis
-        )
-        obs_model = base.observer_model
-        if obs_model is not None:
-            obs_model = obs_model.__class__(
-                obs_model.mass_kg, obs_model.viscous_n_s_per_m, self.coulomb_n, obs_model.axis
-            )
         wall = VirtualWall(k, base.wall.damping_n_s_per_m, base.wall.position, base.wall.normal)
         return base.replace(
             hand=hand,
-            model=model,
-            observer_model=obs_model,
+            model__coulomb_n=self.coulomb_n,  # the plant's and the assumed model's alike
+            device__coulomb_n=self.coulomb_n,
             wall=wall,
             loop__duration_s=self.pulse_at_s + self.observe_s,
         )

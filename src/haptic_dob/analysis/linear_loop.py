@@ -1,13 +1,15 @@
 """The slide's loop in contact as a linear discrete-time system: stability without simulation.
 
-Plant ``m x'' + b x' = u + F_h`` discretised exactly with a zero-order hold at period T; the hand
+Plant ``m x'' + b x' = F_a + F_h`` discretised exactly with a zero-order hold at period T, the
+applied force ``F_a`` the command ``u`` itself or, with an amplifier lag ``tau_a``, its first-order
+lag (``tau_a F_a' = u - F_a``: the observer knows only ``u``); the hand
 ``F_h = F_push - k_h x`` (a push through a grip spring ``k_h``, as in the onset protocol; the
 constant push drops out of the perturbation dynamics); the wall ``F_w = -K x`` on the encoder
 sample; the observer exactly as ``DisturbanceObserver`` updates (pole-matched implicit update,
 backward-difference velocity, the effort applied over the last period) with the plant's m and b,
 so it estimates the hand force; CL with an ideal sensor reading ``F_h`` at the sample. The state
-is ``[x, v, x_prev, v_prev_sample, z_prev, u_prev]``; the loop is stable when every eigenvalue of
-the one-period map lies inside the unit circle.
+is ``[x, v, (F_a,) x_prev, v_prev_sample, z_prev, u_prev]``; the loop is stable when every
+eigenvalue of the one-period map lies inside the unit circle.
 
 It explains what the thesis could not: the discrete observer answers sample k with the effort
 applied over [k-1, k) and a backward-difference velocity, so its estimate carries a piece of the
@@ -28,6 +30,19 @@ from haptic_dob.validation import nonnegative, positive
 MODES = ("OL", "CL", "DOB")
 
 
+def _plant(m: float, b: float, k_h: float, T: float, lag: float) -> tuple[np.ndarray, np.ndarray]:
+    """The plant's exact zero-order-hold map: ``[x, v]``, or ``[x, v, F_a]`` with a lag."""
+    if lag > 0.0:
+        A = np.array([[0.0, 1.0, 0.0], [-k_h / m, -b / m, 1.0 / m], [0.0, 0.0, -1.0 / lag]])
+        B = np.array([[0.0], [0.0], [1.0 / lag]])
+    else:
+        A = np.array([[0.0, 1.0], [-k_h / m, -b / m]])
+        B = np.array([[0.0], [1.0 / m]])
+    n = A.shape[0]
+    Ad, Bd, *_ = cont2discrete((A, B, np.eye(n), np.zeros((n, 1))), T, "zoh")
+    return Ad, Bd[:, 0]
+
+
 def loop_map(
     stiffness: float,
     kf: float,
@@ -37,22 +52,23 @@ def loop_map(
     b: float,
     T: float,
     hand_stiffness: float = 0.0,
+    amplifier_lag_s: float = 0.0,
 ) -> np.ndarray:
-    """The one-period state map (6 x 6) of the loop in contact."""
+    """The one-period state map (6 x 6, or 7 x 7 with an amplifier lag) of the loop in contact."""
     K = nonnegative("stiffness", stiffness)
     k_h = nonnegative("hand_stiffness", hand_stiffness)
+    lag = nonnegative("amplifier_lag_s", amplifier_lag_s)
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     m, T, c = positive("m", m), positive("T", T), positive("gain", gain)
-    A = np.array([[0.0, 1.0], [-k_h / m, -b / m]])
-    B = np.array([[0.0], [1.0 / m]])
-    Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), T, "zoh")
+    Ad, Bd = _plant(m, b, k_h, T, lag)
+    n_p = Ad.shape[0]
     alpha = math.exp(-c * T / m)
     cd = m * math.expm1(c * T / m) / T  # the observer's pole-matched discrete gain
-    e = np.eye(6)
-    x, v, x_prev, qd_prev, z_prev, u_prev = e
-    q = x  # the encoder sample (quantization left out)
-    qd = (x - x_prev) / T
+    e = np.eye(n_p + 4)
+    plant, (x_prev, qd_prev, z_prev, u_prev) = e[:n_p], e[n_p:]
+    q = plant[0]  # the encoder sample of x (quantization left out)
+    qd = (q - x_prev) / T
     z = alpha * z_prev + (1.0 - alpha) * (b * qd_prev - u_prev - cd * qd)
     d_hat = z + cd * qd
     f_wall = -K * q
@@ -62,10 +78,9 @@ def loop_map(
         u = f_wall + kf * (f_wall - k_h * q)
     else:
         u = f_wall + kf * (f_wall + d_hat)
-    M = np.empty((6, 6))
-    M[0] = Ad[0, 0] * x + Ad[0, 1] * v + Bd[0, 0] * u
-    M[1] = Ad[1, 0] * x + Ad[1, 1] * v + Bd[1, 0] * u
-    M[2], M[3], M[4], M[5] = q, qd, z, u
+    M = np.empty((n_p + 4, n_p + 4))
+    M[:n_p] = Ad @ plant + np.outer(Bd, u)
+    M[n_p], M[n_p + 1], M[n_p + 2], M[n_p + 3] = q, qd, z, u
     return M
 
 
@@ -78,9 +93,10 @@ def spectral_radius(
     b: float,
     T: float,
     hand_stiffness: float = 0.0,
+    amplifier_lag_s: float = 0.0,
 ) -> float:
     """Largest eigenvalue magnitude of the loop map (> 1: unstable)."""
-    M = loop_map(stiffness, kf, mode, gain, m, b, T, hand_stiffness)
+    M = loop_map(stiffness, kf, mode, gain, m, b, T, hand_stiffness, amplifier_lag_s)
     return float(np.max(np.abs(np.linalg.eigvals(M))))
 
 
@@ -93,12 +109,13 @@ def linear_onset(
     T: float = 1e-3,
     hand_stiffness: float = 0.0,
     k_max: float = 1e5,
+    amplifier_lag_s: float = 0.0,
 ) -> float | None:
     """Smallest stiffness (N/m) at which the linear loop is unstable; 0 if it is at any; None if
     stable up to ``k_max``. Found by bisection on the spectral radius (1 N/m resolution)."""
 
     def unstable(k: float) -> bool:
-        return spectral_radius(k, kf, mode, gain, m, b, T, hand_stiffness) > 1.0
+        return spectral_radius(k, kf, mode, gain, m, b, T, hand_stiffness, amplifier_lag_s) > 1.0
 
     lo, hi = 0.0, 1.0
     if unstable(0.0):

@@ -104,8 +104,9 @@ def chapter6_runs(
     for mode, kf in controllers or CH6_CONTROLLERS:
         for wall in (walls or CH6_WALLS)[mode]:
             extra: dict[str, dict[str, Any]] = {
-                "/**": {"slide.coulomb_n": p.coulomb_n},
+                "/**": {"slide.coulomb_n": p.coulomb_n},  # the assumed model's
                 "device_node": {
+                    "plant.coulomb_n": p.coulomb_n,  # and the plant's
                     "duration_s": p.pulse_at_s + p.observe_s,
                     "hand.behaviour": "push_hold",
                     "hand.mass_kg": 0.0,

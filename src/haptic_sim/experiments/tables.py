@@ -186,14 +186,14 @@ def dob_tables(d: DobStudy) -> str:
             "**DOB with an observer model that leaves Coulomb friction out** (batch, the "
             "chapter-7 hand; bandwidth Hz / impedance error %):",
             "",
-            "| wall (N/m) | Kf | exact model | no Coulomb in the model |",
+            "| wall (N/m) | Kf | the assumed model | no Coulomb in the model |",
             "|---|---|---|---|",
         ]
         cells = {(c.wall, c.kf, c.observer_model): c for c in d.model_mismatch}
         for wall, kf in sorted({(c.wall, c.kf) for c in d.model_mismatch}):
             cols = [
                 f"{fmt(c.bandwidth_hz)} / {fmt(c.impedance_error_pct, '.1f')}"
-                for c in (cells[(wall, kf, "exact")], cells[(wall, kf, "no Coulomb")])
+                for c in (cells[(wall, kf, "assumed")], cells[(wall, kf, "no Coulomb")])
             ]
             lines.append(f"| {wall:g} | {kf:g} | " + " | ".join(cols) + " |")
     return "\n".join(lines) + "\n"
@@ -205,7 +205,13 @@ def config_table(res: ExperimentResults, base: SessionConfig) -> str:
     m, s, h, d, o = base.model, base.sensor, base.hand, base.device, base.observer
     rows = [
         (
-            "slide",
+            "simulated slide (its truth)",
+            f"m {d.mass_kg} kg, viscous {d.viscous_n_s_per_m} N s/m, Coulomb {d.coulomb_n} N, "
+            f"static {d.stiction_ratio:g} x Coulomb over {1e3 * d.stribeck_velocity_m_per_s:g} "
+            f"mm/s (Stribeck), amplifier lag {1e3 * d.amplifier_lag_s:g} ms",
+        ),
+        (
+            "assumed model (observer, controller)",
             f"m {m.mass_kg} kg, viscous b {m.viscous_n_s_per_m} N s/m, Coulomb {m.coulomb_n} N",
         ),
         ("loop", f"{base.loop.rate_hz:g} Hz, {base.loop.substeps} physics sub-steps, lockstep"),
