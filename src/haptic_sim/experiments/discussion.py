@@ -113,10 +113,11 @@ def phantom_text(p: PhantomResult) -> str:
 
 # --- where the simulation differs from the thesis ----------------------------------------------
 OBSERVER_IS_THE_PLANT = (
-    "- **The observer's model is the plant.** The thesis (7.3.3.1) traces the high-gain "
-    "DOB's lower bandwidth (Kf = 25) to modelling errors that force feedback amplifies "
-    "(friction underestimated at low speed, overshoot at high frequency). Here the "
-    "observer knows the slide exactly, so a higher Kf widens the band instead, up to "
+    "- **The observer's model is nearly the plant.** The thesis (7.3.3.1) traces the "
+    "high-gain DOB's lower bandwidth (Kf = 25) to modelling errors that force feedback "
+    "amplifies (friction underestimated at low speed, overshoot at high frequency). Here "
+    "the observer's model misses only the simulated plant's stiction (1.5 x Coulomb, over "
+    "5 mm/s) and its 0.05 ms amplifier lag, so a higher Kf widens the band instead, up to "
     "`--fmax`. Leaving Coulomb friction out of the observer's model moves the Kf = 25 "
     "cells the thesis's way (narrower band, larger error; the DOB section's last "
     "table) without reaching its 2.9-3.9 Hz."
