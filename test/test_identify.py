@@ -52,7 +52,12 @@ def step(t: float) -> float:
 
 
 def write_bag(
-    path: Path, rec: JointRecord, storage: str, effort: bool = True, topic: str = "/joint_states"
+    path: Path,
+    rec: JointRecord,
+    storage: str,
+    effort: bool = True,
+    topic: str = "/joint_states",
+    stamped: bool = True,
 ) -> Path:
     """A bag as ``ros2 bag record /joint_states`` of a driver would hold it."""
     from rosbags.rosbag2 import StoragePlugin, Writer
@@ -64,7 +69,7 @@ def write_bag(
         conn = writer.add_connection(topic, "sensor_msgs/msg/JointState", typestore=wire.TYPESTORE)
         msg = wire.joint_state(["slide"], "base_link")
         for st, q, u in zip(rec.stamps_ns.tolist(), rec.position, rec.effort, strict=True):
-            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(st), 1_000_000_000)
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(st) * stamped, 10**9)
             msg.position = np.array([q])
             msg.velocity = np.array([0.0])
             msg.effort = np.array([u]) if effort else np.array([], np.float64)
@@ -128,6 +133,20 @@ def _cli(*args: str) -> subprocess.CompletedProcess[str]:
         text=True,
         timeout=120,
     )
+
+
+def test_a_first_sample_stamped_zero_stays_first_and_unstamped_headers_use_receive_times(
+    tmp_path, chirp_record
+) -> None:
+    from haptic_dob.bag.joints import read_joint
+
+    assert chirp_record.stamps_ns[0] == 0  # a lockstep run's sample 0
+    rec = read_joint(write_bag(tmp_path / "a", chirp_record, "mcap"))
+    np.testing.assert_array_equal(rec.stamps_ns, chirp_record.stamps_ns)
+    np.testing.assert_array_equal(rec.position, chirp_record.position)
+    rec = read_joint(write_bag(tmp_path / "b", chirp_record, "sqlite3", stamped=False))
+    np.testing.assert_array_equal(rec.stamps_ns, chirp_record.stamps_ns + 1)  # receive times
+    np.testing.assert_array_equal(rec.effort, chirp_record.effort)
 
 
 def test_bad_bags_get_one_line_and_exit_2(tmp_path, chirp_record) -> None:

@@ -2,8 +2,9 @@
 
 Any rosbag2 bag (MCAP or sqlite3, ours or ``ros2 bag record``'s): a bag holding nothing but
 ``/joint_states`` as a driver publishes it (name, position, velocity, effort) is enough for
-``haptic-identify``. Stamps come from the messages' headers (the receive time where a header
-is zero).
+``haptic-identify``. Stamps come from the messages' headers, or from the receive times when no
+header is stamped (a driver that leaves them zero); a lockstep run's first sample is stamped 0
+legitimately.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ def read_joint(
             raise BagError(f"{shown}: {name} is {topics[name]}, not {JOINT_STATE}")
         conns = [c for c in reader.connections if c.topic == name]
         stamps: list[int] = []
+        received: list[int] = []
         pos: list[float] = []
         eff: list[float] = []
         j, chosen, last_names = 0, joint, None
@@ -50,12 +52,14 @@ def read_joint(
                     "needs the applied effort (the driver's effort field)"
                 )
             st = msg.header.stamp
-            stamp = st.sec * 1_000_000_000 + st.nanosec
-            stamps.append(stamp if stamp else t)
+            stamps.append(st.sec * 1_000_000_000 + st.nanosec)
+            received.append(t)
             pos.append(float(msg.position[j]))
             eff.append(float(msg.effort[j]))
     if not stamps:
         raise BagError(f"{shown}: {name} holds no messages; topics: {listing(topics)}")
+    if not any(stamps):  # no header stamped: the receive times
+        stamps = received
     order = np.argsort(np.asarray(stamps), kind="stable")
     return JointRecord(
         np.asarray(stamps, np.int64)[order],
