@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import pytest
 
+from haptic_dob.command_join import WARM_SAMPLES, CommandJoin
 from haptic_dob.control import ControlMode, ImpedanceController, ImpedanceLaw
-from haptic_dob.cycle import WARM_SAMPLES, CommandJoin, LoopCycle, estimate, wall_force
+from haptic_dob.cycle import LoopCycle, estimate, wall_force
 from haptic_dob.environment import VirtualWall
 from haptic_dob.models import SlideModel
 from haptic_dob.models.factory import build_model

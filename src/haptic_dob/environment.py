@@ -7,6 +7,9 @@ fast gives zero, not an attracting force):
 
     F_w = -max(K delta + B delta', 0) normal        (delta > 0),   0 otherwise
 
+``two_sided`` makes it a spring-damper on both sides of the plane, ``F_w = -(K delta + B delta')
+normal`` everywhere: the virtual spring that holds the device during identification (thesis 4.2).
+
 For the slide along +x with the wall at x_w this is the thesis's ``F_w = -K (x - x_w) - B x'``.
 Forces are tuples of floats (N), the loop's allocation-free form.
 """
@@ -26,7 +29,8 @@ Vec3 = tuple[float, float, float]
 
 @dataclass(frozen=True)
 class VirtualWall:
-    """A unilateral wall: stiffness K (N/m), damping B (N s/m), plane point (m), unit normal."""
+    """A unilateral wall (or a two-sided spring): stiffness K (N/m), damping B (N s/m), plane
+    point (m), unit normal."""
 
     stiffness_n_per_m: float = field(
         default=800.0, metadata=param("wall stiffness K", "N/m", 0.0, 1e6)
@@ -40,6 +44,10 @@ class VirtualWall:
     normal: Vec3 = field(
         default=(1.0, 0.0, 0.0),
         metadata=param("wall normal from free space into the wall (x, y, z), non-zero"),
+    )
+    two_sided: bool = field(
+        default=False,
+        metadata=param("a spring on both sides of the plane (pulls too): identification's spring"),
     )
     _n: Vec3 = field(init=False, repr=False, compare=False)
 
@@ -87,11 +95,12 @@ class VirtualWall:
         n = self._n
         o = self.position
         delta = (p[0] - o[0]) * n[0] + (p[1] - o[1]) * n[1] + (p[2] - o[2]) * n[2]
-        if delta <= 0.0:
+        two_sided = self.two_sided
+        if delta <= 0.0 and not two_sided:
             return (0.0, 0.0, 0.0)
         rate = v[0] * n[0] + v[1] * n[1] + v[2] * n[2]
         mag = self.stiffness_n_per_m * delta + self.damping_n_s_per_m * rate
-        if mag <= 0.0:
+        if mag <= 0.0 and not two_sided:
             return (0.0, 0.0, 0.0)
         return (-mag * n[0], -mag * n[1], -mag * n[2])
 

@@ -22,6 +22,7 @@ from haptic_dob.analysis.transparency import transparency
 from haptic_dob.control import ImpedanceController, ImpedanceLaw
 from haptic_dob.cycle import LoopCycle
 from haptic_dob.environment import VirtualWall
+from haptic_dob.excitation import Excitation
 from haptic_dob.models.slide import SlideParams
 from haptic_dob.observer import ObserverSettings
 from haptic_dob.runtime.params import build, load_node_params, node_view, param, replace_groups
@@ -84,6 +85,7 @@ class SessionConfig:
     sensor: ForceSensorParams = field(default_factory=ForceSensorParams)
     hand: HandParams = field(default_factory=HandParams)
     wall: VirtualWall = field(default_factory=VirtualWall)
+    excitation: Excitation = field(default_factory=Excitation)
     law: ImpedanceLaw = field(default_factory=ImpedanceLaw)
     # the thesis clipped the slide's estimate to the actuator's 4 N
     observer: ObserverSettings = field(default_factory=lambda: ObserverSettings(output_limit=4.0))
@@ -118,6 +120,7 @@ class SessionConfig:
             sensor=build(ForceSensorParams, dev, "sensor."),
             hand=build(HandParams, dev, "hand."),
             wall=build(VirtualWall, env),
+            excitation=build(Excitation, env, "excitation."),
             law=build(ImpedanceLaw, ctl),
             observer=build(ObserverSettings, obs),
         )
@@ -214,7 +217,11 @@ def run_session(config: SessionConfig, cycles: int | None = None) -> SessionResu
     model = config.model.model()
     observer = config.observer.build(model, device.dt)
     cycle = LoopCycle(
-        config.wall, observer, ImpedanceController(model, config.law), device.period_ns
+        config.wall,
+        observer,
+        ImpedanceController(model, config.law),
+        device.period_ns,
+        config.excitation,
     )
     axis = device.model.axis
     ax0, ax1, ax2 = (float(a) for a in axis)

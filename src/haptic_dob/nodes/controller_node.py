@@ -30,8 +30,8 @@ from typing import Any
 
 from rclpy.context import Context
 
+from haptic_dob.command_join import FALLBACKS, CommandJoin
 from haptic_dob.control import ImpedanceController, ImpedanceLaw
-from haptic_dob.cycle import FALLBACKS, CommandJoin
 from haptic_dob.models.factory import build_model, model_specs
 from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
 from haptic_dob.nodes.observer_node import JointMap, pick
@@ -94,7 +94,7 @@ def controller_node_specs() -> list[ParamSpec]:
 
 
 class ControllerNode(LoopNode):
-    """Computes command k from the stamp-k inputs its mode needs (``haptic_dob.cycle``)."""
+    """Computes command k from the stamp-k inputs its mode needs (``haptic_dob.command_join``)."""
 
     def __init__(self, context: Context | None = None, name: str = "controller_node") -> None:
         super().__init__(name, context=context)

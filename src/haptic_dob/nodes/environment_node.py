@@ -1,15 +1,21 @@
-"""environment_node: the virtual wall. ee_pose + ee_twist of sample k -> wrench_desired k."""
+"""environment_node: the virtual wall. ee_pose + ee_twist of sample k -> wrench_desired k.
+
+The wall (``stiffness_n_per_m``, ``damping_n_s_per_m``, ``position``, ``normal``, ``two_sided``)
+and a known force it adds along its normal at the sample's time (``excitation.*``: a step or a
+sine, the identification experiment's input) change at run time.
+"""
 
 from __future__ import annotations
 
 import sys
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 from rclpy.context import Context
 
 from haptic_dob.cycle import wall_force
 from haptic_dob.environment import VirtualWall
+from haptic_dob.excitation import Excitation
 from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
@@ -23,17 +29,30 @@ from haptic_msgs_py.values import StampedVector
 
 
 def environment_node_specs() -> list[ParamSpec]:
-    """Every parameter of the environment node (the wall's change at run time)."""
-    return [*loop_specs(), *input_specs("best_effort"), *process_specs(), *specs_of(VirtualWall)]
+    """Every parameter of the environment node (the wall and the excitation change at run time)."""
+    return [
+        *loop_specs(),
+        *input_specs("best_effort"),
+        *process_specs(),
+        *specs_of(VirtualWall),
+        *specs_of(Excitation, "excitation."),
+    ]
+
+
+class Environment(NamedTuple):
+    """What the node renders: the wall and the excitation it adds."""
+
+    wall: VirtualWall
+    excitation: Excitation
 
 
 class EnvironmentNode(LoopNode):
-    """Renders a unilateral wall; its stiffness, damping, position and normal change at run time."""
+    """Renders a wall (or a two-sided spring) and a known excitation; both change at run time."""
 
     def __init__(self, context: Context | None = None, name: str = "environment_node") -> None:
         super().__init__(name, context=context)
         self.params = ParameterTable(self, environment_node_specs(), self._settings, self._apply)
-        self.wall: VirtualWall = self.params.settings
+        self.wall, self.excitation = self.params.settings
         self._pose: StampedVector | None = None
         self._twist: StampedVector | None = None
         self._period_ns = round(1e9 / self.params.values["rate_hz"])
@@ -53,6 +72,8 @@ class EnvironmentNode(LoopNode):
             "damping_n_s_per_m": w.damping_n_s_per_m,
             "position": list(w.position),
             "normal": list(w.normal),
+            "two_sided": w.two_sided,
+            "excitation": self.excitation.label(),
         }
         if self.diagnostics.rate_hz == 0.0:
             return WARN, "no ee_pose/ee_twist pairs in the last second", values
@@ -64,12 +85,12 @@ class EnvironmentNode(LoopNode):
         return None if last < 0 else last + self._period_ns
 
     @staticmethod
-    def _settings(values: Mapping[str, Any]) -> VirtualWall:
-        return build(VirtualWall, values)
+    def _settings(values: Mapping[str, Any]) -> Environment:
+        return Environment(build(VirtualWall, values), build(Excitation, values, "excitation."))
 
-    def _apply(self, wall: VirtualWall) -> None:
-        self.wall = wall
-        self.get_logger().info(f"wall now {wall}")
+    def _apply(self, env: Environment) -> None:
+        self.wall, self.excitation = env
+        self.get_logger().info(f"wall now {env.wall}, excitation {env.excitation.label()}")
 
     def _on_pose(self, pose: StampedVector) -> None:
         self._pose = pose
@@ -85,9 +106,8 @@ class EnvironmentNode(LoopNode):
 
     def _emit(self, pose: StampedVector, twist: StampedVector) -> None:
         self._emitted_ns = pose.stamp_ns
-        self._pub.publish(
-            StampedVector(pose.stamp_ns, wall_force(self.wall, pose.vector, twist.vector))
-        )
+        force = wall_force(self.wall, pose.vector, twist.vector, self.excitation, pose.stamp_ns)
+        self._pub.publish(StampedVector(pose.stamp_ns, force))
         self.diagnostics.tick()
 
 
