@@ -153,6 +153,43 @@ def test_the_plan_holds_the_thesis_cells(root) -> None:
     assert all(r.params["/**"]["slide.coulomb_n"] == 0.0 for r in ch6)
 
 
+def test_chapter_4_runs_hold_the_slide_in_a_spring_and_add_the_thesiss_inputs(root) -> None:
+    from haptic_sim.experiments import ch4
+
+    runs = ch4.chapter4_runs(root / "config" / "slide_sim.yaml")
+    assert [r.name for r in runs] == [
+        "ch4_step_2p4",
+        "ch4_step_1p6",
+        "ch4_step_3p2",
+        "ch4_sine_0p6",
+    ]
+    for r in runs:
+        env = r.params["environment_node"]
+        assert env["two_sided"] and env["stiffness_n_per_m"] == 80.0
+        assert r.params["device_node"]["hand.behaviour"] == "none"
+        assert r.params["controller_node"]["mode"] == "OL" and "observer_node" not in r.params
+        assert "joint_states" in r.params["recorder_node"]["topics"]
+    assert runs[-1].params["environment_node"]["excitation.frequency_hz"] == 2.0
+
+
+def test_chapter_4_checks_hold_least_squares_and_the_step_method_to_their_bounds() -> None:
+    from haptic_dob.identification import SlideFit
+    from haptic_sim.experiments.ch4 import ch4_checks
+    from haptic_sim.slide import SlideDeviceParams
+
+    truth = SlideDeviceParams()  # m 0.416, c 1.272, Fc 0.24
+
+    def fit(method: str, m: float, c: float, fc: float | None) -> SlideFit:
+        return SlideFit(method, "slide", m, c, fc, None, None, None, 100, None)
+
+    checks = ch4_checks(
+        [fit("least_squares", 0.43, 1.31, 0.29), fit("step", 0.41, 1.5, None)], truth
+    )
+    assert [c.passed for c in checks] == [True, False]  # m 3.4 %, c 3.0 %, Fc 20.8 %; c 17.9 %
+    checks = ch4_checks([fit("least_squares", 0.44, 1.27, 0.24)], truth)
+    assert not checks[0].passed and "m 5.8 %" in checks[0].text
+
+
 def _row(mode: str, kf: float, wall: float, growth: float | None, vib: bool) -> RunAnalysis:
     return RunAnalysis(
         "ch6",

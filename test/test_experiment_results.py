@@ -10,7 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from haptic_sim.experiments import dob, report, results
+from haptic_dob.identification import SlideFit
+from haptic_sim.experiments import ch4, dob, report, results
 from haptic_sim.experiments.jsonio import from_json, to_json
 from haptic_sim.experiments.parts import (
     EXPERIMENTS,
@@ -44,7 +45,21 @@ def _every_part() -> dict[str, object]:
         _run("ch6", "OL", 0.0, 2800.0, perturbation_growth_per_s=None, perturbation_vibrates=True),
     ]
     kick = [dob.KickPoint(w, 2.0, 0.24, 1e-5 * w / 4000.0, 30.0) for w in dob.WALLS]
+    fits = [
+        SlideFit("least_squares", "slide", 0.42, 1.25, 0.245, 1e-3, 0.02, 4e-3, 900, 0.01),
+        SlideFit("step", "slide", 0.41, 2.04, None, None, None, None, 3500, None),
+    ]
     return {
+        "ch4": ch4.Ch4Result(
+            fits,
+            [
+                ch4.Prediction(ch4.run_name(e), e.label(), f.method, 0.1, -0.05, [0.0, 1.5])
+                for e in (ch4.IDENTIFY, *ch4.VERIFY)
+                for f in fits
+            ],
+            {ch4.run_name(e): [0.0, 1.4] for e in (ch4.IDENTIFY, *ch4.VERIFY)},
+            ch4.ch4_checks(fits, BASE.device),
+        ),
         "ch7": results.ch7_result(ch7),
         "ch6": results.ch6_result(ch6, BASE),
         "map": StabilityMap(
@@ -81,6 +96,7 @@ def test_results_json_round_trips_through_the_dataclasses(tmp_path: Path) -> Non
     data = json.loads(text)
     assert list(data["results"]) == list(PARTS)
     assert data["results"]["ch7"]["rows"][0]["bandwidth_hz"] == 1.08
+    assert data["results"]["ch4"]["fits"][1]["coulomb_n"] is None
     assert data["results"]["ch6"]["onsets"][0]["points"][1]["growth_per_s"] is None
     assert data["results"]["dob"]["kick"][-1]["vibrates"] is True  # derived, for the reader
     assert '\n  "ch7": {\n' in text
@@ -152,7 +168,7 @@ def test_a_run_analysis_takes_haptic_analyze_figures_by_name() -> None:
 
 
 def test_the_table_names_each_part_and_figure_once() -> None:
-    assert len(set(PARTS)) == len(PARTS) == 5 and QUICK_PARTS == ["ch7"]
+    assert len(set(PARTS)) == len(PARTS) == 6 and QUICK_PARTS == ["ch7"]
     files = [f.file for e in EXPERIMENTS for f in e.figures]
     assert len(set(files)) == len(files)
 

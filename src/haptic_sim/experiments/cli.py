@@ -1,7 +1,9 @@
-"""``haptic-experiment``: the thesis's chapters 6 and 7 through the node graph, and a report.
+"""``haptic-experiment``: the thesis's chapters 4, 6 and 7 through the node graph, and a report.
 
 Parts (``--parts``, all by default):
 
+- ``ch4``: identification (a 2.4 N step under an 80 N/m spring) and model verification (1.6 N and
+  3.2 N steps, a 0.6 N 2 Hz sine) through the node graph, recorded and identified from the bags;
 - ``ch7``: transparency, OL / CL Kf=2 / DOB Kf=1 / DOB Kf=25 on walls of 80-2400 N/m, 40 s of
   semi-random hand motion each, run through the node graph in lockstep and recorded;
 - ``ch6``: vibration onset through the node graph (push-and-hold protocol, pulse response);

@@ -17,7 +17,8 @@ from haptic_sim.experiments.zwidth import K_MAX, K_MIN, MapPoint
 from haptic_sim.session import SessionResult
 
 
-def _plt() -> Any:
+def pyplot() -> Any:
+    """matplotlib.pyplot on the Agg backend."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -26,16 +27,17 @@ def _plt() -> Any:
     return plt
 
 
-def _save(fig: Any, path: Path) -> None:
+def save_figure(fig: Any, path: Path) -> None:
+    """Lay out, write as PNG at 120 dpi, close."""
     fig.tight_layout()
     fig.savefig(path, dpi=120)
-    _plt().close(fig)
+    pyplot().close(fig)
 
 
 # --- chapters 7 and 6 through the graph ---------------------------------------------------------
 def plot_ch7(rows: list[RunAnalysis], path: Path) -> None:
     """Bandwidth and impedance error against the wall, simulation (solid) and thesis (dashed)."""
-    plt = _plt()
+    plt = pyplot()
     ctls, walls, cells = ch7_grid(rows)
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
     panels: tuple[tuple[Any, Callable[[RunAnalysis], float | None], dict[Any, Any]], ...] = (
@@ -62,12 +64,12 @@ def plot_ch7(rows: list[RunAnalysis], path: Path) -> None:
         ax.grid(True, alpha=0.3)
     ax1.legend(fontsize=8, title="simulation (o), thesis (x, dashed)", title_fontsize=7)
     fig.suptitle("Chapter 7 through the node graph")
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def plot_ch6(onsets: list[GraphOnset], path: Path, b: float, rate_hz: float) -> None:
     """Growth rate against the wall per controller, the zero line and the bounds."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     for i, e in enumerate(onsets):
         grows = [(p.wall, p.growth_per_s) for p in e.points if p.growth_per_s is not None]
@@ -91,13 +93,13 @@ def plot_ch6(onsets: list[GraphOnset], path: Path, b: float, rate_hz: float) -> 
     ax.set_title("Chapter 6 through the node graph (dotted: 2b/(T(1+Kf)))")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # --- the stability map --------------------------------------------------------------------------
 def plot_onset_vs_kf(points: list[MapPoint], path: Path, b: float, T: float) -> None:
     """Onset stiffness against Kf per controller at B = 0, with the passivity bound."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     kfs = np.geomspace(0.1, 200, 200)
     ax.loglog(kfs, 2 * b / (T * (1 + kfs)), "k--", label="bound 2b/(T(1+Kf))")
@@ -128,12 +130,12 @@ def plot_onset_vs_kf(points: list[MapPoint], path: Path, b: float, T: float) -> 
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title("Slide: onset against force gain (push-and-hold protocol)")
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def plot_zwidth(points: list[MapPoint], path: Path) -> None:
     """Z-width: largest vibration-free stiffness against wall damping, per controller."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     groups: dict[tuple[str, float], list[MapPoint]] = {}
     for p in points:
@@ -151,13 +153,13 @@ def plot_zwidth(points: list[MapPoint], path: Path) -> None:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, title="measured (solid), passivity bound (dotted)", title_fontsize=7)
     ax.set_title("Z-width of the slide (batch simulation)")
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 # --- the DOB question ---------------------------------------------------------------------------
 def plot_kick_grid(points: list[KickPoint], path: Path) -> None:
     """Residual RMS against wall stiffness, one line per (c, Coulomb)."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     for c, fc in sorted({(p.gain, p.coulomb_n) for p in points}):
         row = sorted(
@@ -176,12 +178,12 @@ def plot_kick_grid(points: list[KickPoint], path: Path) -> None:
     ax.set_title("DOB Kf = 100 on the slide: what stops the vibration")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def plot_kick_traces(runs: dict[str, SessionResult], stiffness: float, path: Path) -> None:
     """Depth and command around the kick, with and without Coulomb friction (runs by name)."""
-    plt = _plt()
+    plt = pyplot()
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
     for name, r in runs.items():
         ax1.plot(r.t, r.x_true * 1e3, lw=0.8, label=name)
@@ -194,4 +196,4 @@ def plot_kick_traces(runs: dict[str, SessionResult], stiffness: float, path: Pat
     for ax in (ax1, ax2):
         ax.grid(True, alpha=0.3)
     ax2.set_xlim(1.3, 2.5)
-    _save(fig, path)
+    save_figure(fig, path)

@@ -17,6 +17,8 @@ from pathlib import Path
 from typing import Any, Generic, TypeVar
 
 from haptic_sim.experiments import (
+    ch4,
+    ch4_report,
     discussion,
     dob,
     figures,
@@ -113,6 +115,24 @@ def _kick_traces(base: SessionConfig, path: Path) -> None:
     figures.plot_kick_traces(dob.traces(base, wall), wall, path)
 
 
+CH4: Experiment[ch4.Ch4Result] = Experiment(
+    part="ch4",
+    result_type=ch4.Ch4Result,
+    job=GraphJob(ch4.chapter4_runs, ch4.ch4_result),
+    heading="Chapter 4: identification and model verification through the node graph",
+    intro="The graph holds the simulated slide in an 80 N/m two-sided virtual spring (OL, no "
+    "hand) while the environment adds a known force: the thesis's 2.4 N step to identify the "
+    "model, 1.6 N and 3.2 N steps and a 0.6 N, 2 Hz sine to verify it. Each run is a bag; "
+    "`haptic-identify`'s core reads the joint states of the 2.4 N bag.",
+    body=lambda r, base: [ch4_report.ch4_tables(r, base)],
+    figures=(
+        Figure("ch4_identification.png", "thesis figure 4.2", ch4_report.plot_identification),
+        Figure("ch4_verification.png", "thesis figure 4.3", ch4_report.plot_verification),
+    ),
+    notes=lambda r: [ch4_report.ch4_notes(r)],
+    checks=lambda r: r.checks,
+    console=ch4_report.ch4_console,
+)
 CH7: Experiment[Ch7Result] = Experiment(
     part="ch7",
     result_type=Ch7Result,
@@ -211,7 +231,7 @@ PHANTOM: Experiment[phantom.PhantomResult] = Experiment(
     figures=(Figure("thesis_5_2_1.png", "5.2.1"), Figure("thesis_5_2_2.png", "5.2.2")),
 )
 #: the parts in the report's order
-EXPERIMENTS: tuple[Experiment[Any], ...] = (CH7, CH6, MAP, DOB, PHANTOM)
+EXPERIMENTS: tuple[Experiment[Any], ...] = (CH4, CH7, CH6, MAP, DOB, PHANTOM)
 PARTS: tuple[str, ...] = tuple(e.part for e in EXPERIMENTS)
 QUICK_PARTS: list[str] = [e.part for e in EXPERIMENTS if e.quick]
 

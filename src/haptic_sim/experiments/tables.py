@@ -223,7 +223,7 @@ def config_table(res: ExperimentResults, base: SessionConfig) -> str:
         (
             "observer",
             f"c = {o.gain} N s/m (m/c = {1e3 * m.mass_kg / o.gain:.0f} ms), output "
-            f"limit {o.output_limit} N, model = the plant",
+            f"limit {o.output_limit} N, model = the assumed model above",
         ),
         ("controller", f"saturation {base.law.max_force_n} N"),
         (

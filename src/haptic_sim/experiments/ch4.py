@@ -1,0 +1,190 @@
+"""Chapter 4 through the node graph: identify the slide (4.2) and verify the model (4.3).
+
+As the thesis did on its device, and as a lab does: the graph holds the simulated slide in an
+80 N/m two-sided virtual spring (OL, no hand) and the environment adds a known force (the
+identification's 2.4 N step; the verification's 1.6 N and 3.2 N steps and 0.6 N, 2 Hz sine),
+each run recorded as a bag. ``haptic-identify``'s core finds the model in the 2.4 N bag's joint
+states by least squares and by the thesis's step method; each identified model then predicts
+every run (a batch simulation of the model alone, under the same spring and input) and the
+prediction is set against the recorded positions. The plant's truth (``plant.*``, with stiction
+and an amplifier lag the model leaves out) is shown beside what was identified.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from haptic_dob.bag.joints import read_joint
+from haptic_dob.control import ControlMode, ImpedanceLaw
+from haptic_dob.environment import VirtualWall
+from haptic_dob.excitation import Excitation
+from haptic_dob.identification import SlideFit, identify
+from haptic_dob.models.slide import SlideParams
+from haptic_sim.experiments.graph_runs import GraphRun, session_params
+from haptic_sim.experiments.records import Cell, Check, RunAnalysis
+from haptic_sim.hand import HandParams
+from haptic_sim.session import SessionConfig, run_session
+from haptic_sim.slide import SlideDeviceParams
+
+SPRING_N_PER_M = 80.0
+START_S = 1.5  # the input starts here (after the analysis's settle time; the slide rests before)
+DURATION_S = 5.0
+IDENTIFY = Excitation("step", 2.4, START_S)
+VERIFY = (
+    Excitation("step", 1.6, START_S),
+    Excitation("step", 3.2, START_S),
+    Excitation("sine", 0.6, START_S, 2.0),
+)
+RECORDED = ["joint_states", "ee_pose", "ee_twist", "wrench_measured", "/parameter_events"]
+METHODS = ("least_squares", "step")
+TRACE_HZ = 200.0  # the traces kept in results.json for the figures
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """One identified model against one run: RMS and final position errors (mm), the traces."""
+
+    run: str
+    excitation: str
+    method: str
+    rms_error_mm: float
+    final_error_mm: float  # mean over the last 0.5 s, predicted - measured
+    predicted_mm: list[float]  # at TRACE_HZ
+
+
+@dataclass(frozen=True)
+class Ch4Result:
+    """The models identified from the 2.4 N bag, their predictions, the measured traces."""
+
+    fits: list[SlideFit]
+    predictions: list[Prediction]
+    measured_mm: dict[str, list[float]]  # run name -> positions at TRACE_HZ
+    checks: list[Check]
+
+
+def excitation_params(e: Excitation) -> dict[str, object]:
+    """The environment node's ``excitation.*`` for ``e``."""
+    return {
+        "excitation.kind": e.kind,
+        "excitation.amplitude_n": e.amplitude_n,
+        "excitation.at_s": e.at_s,
+        "excitation.frequency_hz": e.frequency_hz,
+    }
+
+
+def run_name(e: Excitation) -> str:
+    """``ch4_step_2p4``, ``ch4_sine_0p6``..."""
+    return f"ch4_{e.kind}_{e.amplitude_n:g}".replace(".", "p")
+
+
+def chapter4_runs(base_config: Path, _seed: int = 0, _quick: bool = False) -> list[GraphRun]:
+    """The identification run and the three verification runs (OL, no hand, the spring)."""
+    runs = []
+    for e in (IDENTIFY, *VERIFY):
+        params = session_params(
+            base_config,
+            {
+                "controller_node": {"mode": "OL", "kf": 0.0, "warm_inputs": False},
+                "device_node": {
+                    "wait_for": ["environment_node", "controller_node"],
+                    "duration_s": DURATION_S,
+                    "hand.behaviour": "none",
+                },
+                "environment_node": {
+                    "stiffness_n_per_m": SPRING_N_PER_M,
+                    "damping_n_s_per_m": 0.0,
+                    "two_sided": True,
+                    **excitation_params(e),
+                },
+                "recorder_node": {"topics": RECORDED},
+            },
+        )
+        params.pop("observer_node", None)
+        cell = Cell("ch4", "OL", 0.0, SPRING_N_PER_M)
+        runs.append(GraphRun(run_name(e), params, cell, f"ch4 {e.label()} under the spring"))
+    return runs
+
+
+def predicted_positions(fit: SlideFit, e: Excitation, base: SessionConfig) -> np.ndarray:
+    """The identified model alone (its mass, viscous and Coulomb friction) under the spring and
+    ``e``: positions (m) of every sample, as the graph's run has them."""
+    model = SlideParams(fit.mass_kg, fit.viscous_n_s_per_m, fit.coulomb_n or 0.0)
+    plant = SlideDeviceParams.matching(
+        model,
+        max_force_n=base.device.max_force_n,
+        encoder_resolution_m=base.device.encoder_resolution_m,
+    )
+    cfg = SessionConfig(
+        loop=base.loop,
+        model=model,
+        device=plant,
+        hand=HandParams(behaviour="none"),
+        wall=VirtualWall(SPRING_N_PER_M, two_sided=True),
+        excitation=e,
+        law=ImpedanceLaw(ControlMode.OL),
+    ).replace(loop__duration_s=DURATION_S)
+    return run_session(cfg).q
+
+
+def _decimate(x: np.ndarray, rate_hz: float) -> list[float]:
+    step = max(1, round(rate_hz / TRACE_HZ))
+    return [round(float(v) * 1e3, 4) for v in x[::step]]
+
+
+def ch4_result(rows: list[RunAnalysis], base: SessionConfig) -> Ch4Result:
+    """Identify from the first run's bag, predict every run with each model, check the fits."""
+    records = {r.name: read_joint(r.bag) for r in rows}
+    ident = records[run_name(IDENTIFY)]
+    fits = [identify(ident, m) for m in METHODS]
+    rate = base.loop.rate_hz
+    excitations = {run_name(e): e for e in (IDENTIFY, *VERIFY)}
+    predictions, measured = [], {}
+    for name, rec in records.items():
+        x = rec.position
+        measured[name] = _decimate(x, rate)
+        tail = slice(-round(0.5 * rate), None)
+        for fit in fits:
+            xp = predicted_positions(fit, excitations[name], base)
+            n = min(len(xp), len(x))
+            err = xp[:n] - x[:n]
+            predictions.append(
+                Prediction(
+                    name,
+                    excitations[name].label(),
+                    fit.method,
+                    float(np.sqrt(np.mean(err * err))) * 1e3,
+                    float(np.mean(xp[:n][tail]) - np.mean(x[:n][tail])) * 1e3,
+                    _decimate(xp, rate),
+                )
+            )
+    return Ch4Result(fits, predictions, measured, ch4_checks(fits, base.device))
+
+
+def ch4_checks(fits: list[SlideFit], truth: SlideDeviceParams) -> list[Check]:
+    """Least squares within 5 % (m, c) and 25 % (Fc) of the plant's truth; the step method
+    within 15 % (m, c)."""
+
+    def off(got: float | None, want: float) -> float:
+        return abs((got if got is not None else 0.0) - want) / want
+
+    out = []
+    for fit in fits:
+        m, c = off(fit.mass_kg, truth.mass_kg), off(fit.viscous_n_s_per_m, truth.viscous_n_s_per_m)
+        if fit.method == "least_squares":
+            fc = off(fit.coulomb_n, truth.coulomb_n)
+            ok = m <= 0.05 and c <= 0.05 and fc <= 0.25
+            text = (
+                f"least squares on the 2.4 N bag: m {100 * m:.1f} %, c {100 * c:.1f} % (within "
+                f"5 %) and Fc {100 * fc:.1f} % (within 25 %) of the plant's truth"
+            )
+        else:
+            ok = m <= 0.15 and c <= 0.15
+            text = (
+                f"step method on the 2.4 N bag: m {100 * m:.1f} % and c {100 * c:.1f} % of the "
+                "plant's truth (within 15 %)"
+            )
+        out.append(Check(text, ok))
+    return out
