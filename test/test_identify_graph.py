@@ -11,9 +11,13 @@ from __future__ import annotations
 import json
 import subprocess
 
+import numpy as np
 import pytest
 
 from conftest import tool
+from haptic_dob.bag.joints import read_joint
+from haptic_dob.runtime.params import load_node_params
+from haptic_sim.session import SessionConfig, run_session
 from haptic_sim.slide import SlideDeviceParams
 from rosgraph import isolated_env
 
@@ -43,7 +47,13 @@ def test_the_graph_bag_gives_the_plants_model_and_the_observer_loads_it(
         if p["method"] == "least_squares":
             assert p["rms_error_mm"] < 0.5, p["excitation"]
 
-    bag, model = out / "runs" / "ch4_step_2p4" / "bag", tmp_path / "model.yaml"
+    # the lockstep graph with its excitation is the batch run, to the bit
+    run_dir = out / "runs" / "ch4_step_2p4"
+    cfg = SessionConfig.from_node_params(load_node_params(run_dir / "params.yaml"))
+    batch = run_session(cfg).q  # samples 0..N-1; the graph also sends sample N, its last
+    np.testing.assert_array_equal(read_joint(run_dir / "bag").position[: len(batch)], batch)
+
+    bag, model = run_dir / "bag", tmp_path / "model.yaml"
     cli = subprocess.run(
         [tool("haptic-identify"), str(bag), "--json", "--write-yaml", str(model)],
         capture_output=True,
