@@ -19,6 +19,7 @@ import pytest
 
 from armsim import AbaArm
 from haptic_dob.models import UrdfModel
+from haptic_dob.models.factory import build_model
 from haptic_dob.observer import DisturbanceObserver
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -90,6 +91,39 @@ def test_fixed_joints_and_the_gripper_are_locked_and_meshes_never_read(tmp_path:
         assert pin.computeTotalMass(model._model) == pytest.approx(11.1)  # arm, hand, fingers
 
 
+def test_joint_friction_comes_from_the_urdf_and_can_be_given() -> None:
+    """``<dynamics damping friction>`` (arm6: 0.05 N m s/rad, 0.2 N m) is the model's joint
+    friction ``b q' + Fc sgn(q')`` unless given; the rigid-body terms stay as they are."""
+    urdf, bare = UrdfModel(ARM6, "tcp"), UrdfModel(ARM6, "tcp", viscous=0.0, coulomb=0.0)
+    assert urdf.viscous.tolist() == [0.05] * 6 and urdf.coulomb.tolist() == [0.2] * 6
+    for q, qd in random_states(6):
+        np.testing.assert_allclose(
+            urdf.bias_effort(q, qd) - bare.bias_effort(q, qd),
+            0.05 * qd + 0.2 * np.sign(qd),
+            atol=1e-12,
+        )
+        np.testing.assert_allclose(urdf.friction(qd), 0.05 * qd + 0.2 * np.sign(qd))
+    given = build_model(
+        {
+            "model": "urdf",
+            "urdf_path": str(ARM6),
+            "tip_frame": "tcp",
+            "urdf.viscous_n_m_s_per_rad": [0.1, 0.1, 0.1, 0.2, 0.2, 0.2],
+            "urdf.coulomb_n_m": [0.0],
+        }
+    )
+    assert given.viscous.tolist() == [0.1] * 3 + [0.2] * 3 and not given.coulomb.any()
+    with pytest.raises(ValueError, match=r"coulomb must have shape \(6,\)"):
+        build_model(
+            {
+                "model": "urdf",
+                "urdf_path": str(ARM6),
+                "tip_frame": "tcp",
+                "urdf.coulomb_n_m": [0.1, 0.2],
+            }
+        )
+
+
 def with_joint(kind: str) -> str:
     """arm6 with a ``kind`` joint between the world and its base."""
     return ARM6.read_text().replace(
@@ -131,7 +165,7 @@ def known_force_error(xml: str, tip: str, start, swing_rad: float) -> float:
     puts its slowest time constant at ``TAU_OBS``. Before the force, the estimate must stay
     within 1 % of ``|FORCE|`` too.
     """
-    model = UrdfModel(xml, tip)
+    model = UrdfModel(xml, tip, viscous=0.0, coulomb=0.0)  # the simulator has no joint friction
     start = np.asarray(start, dtype=np.float64)
     sim = AbaArm(xml, tip, model.joint_names, start, FORCE, T_ON)
     D0 = model.mass_matrix(start)

@@ -98,6 +98,8 @@ class PinocchioModel(DeviceModel):
         S: constant map from our coordinates to pinocchio's (``q_t = S q``), None = identity.
         gravity: False leaves gravity out (G = 0), e.g. for an observer's model (thesis 5.2.1).
         viscous: viscous joint friction b (N m s/rad or N s/m), scalar or per joint, >= 0.
+        coulomb: Coulomb joint friction Fc (N m or N), scalar or per joint, >= 0: the joint
+            friction is ``b q' + Fc sgn(q')``.
     """
 
     def __init__(
@@ -109,6 +111,7 @@ class PinocchioModel(DeviceModel):
         *,
         gravity: bool = True,
         viscous: float | Sequence[float] = 0.0,
+        coulomb: float | Sequence[float] = 0.0,
     ) -> None:
         self.dof = len(joint_names)
         self.joint_names = tuple(joint_names)
@@ -132,14 +135,17 @@ class PinocchioModel(DeviceModel):
         # continuous joints: pinocchio's configuration is (cos, sin), ours the angle
         self._angles_to_config = model.nq != model.nv
         self._neutral = pin.neutral(model)
-        visc = np.asarray(viscous, dtype=np.float64)
-        visc = (
-            np.full(self.dof, float(visc)) if visc.ndim == 0 else vector("viscous", visc, self.dof)
-        )
-        if np.any(visc < 0.0) or not np.all(np.isfinite(visc)):
-            raise ValueError(f"viscous must be finite and >= 0, got {visc.tolist()}")
-        self.viscous = visc
-        self._has_friction = bool(np.any(visc > 0.0))
+        self.viscous = self._per_joint("viscous", viscous)
+        self.coulomb = self._per_joint("coulomb", coulomb)
+        self._has_friction = bool(np.any(self.viscous > 0.0) or np.any(self.coulomb > 0.0))
+
+    def _per_joint(self, name: str, value: float | Sequence[float]) -> Vec:
+        """A scalar for every joint, or one value per joint; finite and >= 0."""
+        v = np.asarray(value, dtype=np.float64)
+        v = np.full(self.dof, float(v)) if v.ndim == 0 else vector(name, v, self.dof)
+        if np.any(v < 0.0) or not np.all(np.isfinite(v)):
+            raise ValueError(f"{name} must be finite and >= 0, got {v.tolist()}")
+        return v
 
     # --- our coordinates to pinocchio's ------------------------------------------------------
     def _conf(self, q: Vec) -> Vec:
@@ -177,8 +183,17 @@ class PinocchioModel(DeviceModel):
         D = self._ours(pin.crba(m, d, qt))
         h = self._effort(pin.rnea(m, d, qt, self._vel(qd), self._zero_t))
         if self._has_friction:
-            h += self.viscous * qd
+            h += self._friction(qd)
         return D, h
+
+    def inverse_dynamics(self, q: Vec, qd: Vec, qdd: Vec) -> Vec:
+        """The effort ``D q'' + C q' + G + friction`` that moves the arm so (RNEA, validated)."""
+        q_, qd_, qdd_ = self._q(q), self._qd(qd), self._qd(qdd)
+        m, d = self._model, self._data
+        tau = self._effort(pin.rnea(m, d, self._conf(q_), self._vel(qd_), self._vel(qdd_)))
+        if self._has_friction:
+            tau += self._friction(qd_)
+        return tau
 
     # --- DeviceModel ---------------------------------------------------------------------------
     def _mass_matrix(self, q: Vec) -> Mat:
@@ -195,12 +210,13 @@ class PinocchioModel(DeviceModel):
         return self._effort(pin.computeGeneralizedGravity(self._model, self._data, self._conf(q)))
 
     def _friction(self, qd: Vec) -> Vec:
-        return self.viscous * qd
+        f: Vec = self.viscous * qd + self.coulomb * np.sign(qd)
+        return f
 
     def _bias_effort(self, q: Vec, qd: Vec) -> Vec:
         h = self._rnea(q, qd)
         if self._has_friction:
-            h += self.viscous * qd
+            h += self._friction(qd)
         return h
 
     def _jacobian(self, q: Vec) -> Mat:
@@ -241,7 +257,7 @@ class PinocchioModel(DeviceModel):
         acc = pin.getFrameClassicalAcceleration(m, d, fid, _LWA).linear.copy()
         D, h = self._ours(d.M), self._effort(d.nle)
         if self._has_friction:
-            h += self.viscous * qd
+            h += self._friction(qd)
         return D, h, p, J, acc
 
     def potential_energy(self, q: Vec) -> float:

@@ -42,6 +42,8 @@ class UrdfArm:
     joint_names: tuple[str, ...]  # the DeviceModel's joint order
     S: np.ndarray | None  # pinocchio velocity order from ours (a permutation), None = same
     effort_limits: tuple[float, ...]  # from the URDF's <limit effort>, N m or N (0 = none)
+    damping: tuple[float, ...]  # <dynamics damping>: viscous friction, N m s/rad or N s/m
+    friction: tuple[float, ...]  # <dynamics friction>: Coulomb friction, N m or N
 
 
 def read_urdf(urdf: str | Path) -> str:
@@ -149,4 +151,6 @@ def urdf_model(
             S[theirs, ours] = 1.0
     limits = tuple(float(model.effortLimit[i]) for i in idx_v)
     limits = tuple(v if math.isfinite(v) and v > 0.0 else 0.0 for v in limits)
-    return UrdfArm(model, frame_id(model, tip_frame), tuple(wanted), S, limits)
+    damping = tuple(float(model.damping[i]) for i in idx_v)
+    friction = tuple(float(model.friction[i]) for i in idx_v)
+    return UrdfArm(model, frame_id(model, tip_frame), tuple(wanted), S, limits, damping, friction)

@@ -28,7 +28,10 @@ class UrdfModel(PinocchioModel):
         tip_frame: the link or frame whose origin is the end-effector point.
         joint_names: the joints to use, in this order (default: the chain to ``tip_frame``).
         gravity: False leaves gravity out of the model.
-        viscous: viscous joint friction (N m s/rad or N s/m), scalar or per joint, default 0.
+        viscous: viscous joint friction (N m s/rad or N s/m), scalar or per joint; None: each
+            joint's ``<dynamics damping>`` from the URDF (0 where it has none).
+        coulomb: Coulomb joint friction (N m or N), scalar or per joint; None: each joint's
+            ``<dynamics friction>`` from the URDF.
 
     Raises ``ValueError`` with a clear message for a bad URDF, an unknown frame or joint, or a
     joint that cannot be a coordinate (floating, planar, a mimic joint named in ``joint_names``).
@@ -41,7 +44,8 @@ class UrdfModel(PinocchioModel):
         joint_names: Sequence[str] | None = None,
         *,
         gravity: bool = True,
-        viscous: float | Sequence[float] = 0.0,
+        viscous: float | Sequence[float] | None = None,
+        coulomb: float | Sequence[float] | None = None,
     ) -> None:
         if not str(tip_frame):
             raise ValueError("tip_frame must name a frame of the URDF, got ''")
@@ -50,7 +54,13 @@ class UrdfModel(PinocchioModel):
         #: per-joint effort limits from the URDF's <limit effort=...> (0 where none)
         self.effort_limits = arm.effort_limits
         super().__init__(
-            arm.model, arm.frame_id, arm.joint_names, arm.S, gravity=gravity, viscous=viscous
+            arm.model,
+            arm.frame_id,
+            arm.joint_names,
+            arm.S,
+            gravity=gravity,
+            viscous=arm.damping if viscous is None else viscous,
+            coulomb=arm.friction if coulomb is None else coulomb,
         )
 
     def __repr__(self) -> str:
@@ -95,8 +105,16 @@ class UrdfSettings:
             self.tip_frame,
             names or None,
             gravity=opts.gravity,
-            viscous=opts.viscous_n_m_s_per_rad,
+            viscous=_friction(opts.viscous_n_m_s_per_rad),
+            coulomb=_friction(opts.coulomb_n_m),
         )
+
+
+def _friction(values: Sequence[float]) -> float | list[float] | None:
+    """None for [] (the URDF's values), the value for one, the list for one per joint."""
+    if not values:
+        return None
+    return float(values[0]) if len(values) == 1 else [float(v) for v in values]
 
 
 @dataclass(frozen=True)
@@ -107,6 +125,24 @@ class UrdfOptions:
         default=True,
         metadata=param("include gravity in the model (false: an observer that leaves G out)"),
     )
-    viscous_n_m_s_per_rad: float = field(
-        default=0.0, metadata=param("viscous joint friction", "N m s/rad", 0.0, 1e3)
+    # list defaults: a tuple default would fix the array's length in the parameter table
+    viscous_n_m_s_per_rad: list[float] | tuple[float, ...] = field(
+        default_factory=list,
+        metadata=param(
+            "viscous joint friction, one value for every joint or one per joint; [] = each "
+            "joint's <dynamics damping> from the URDF",
+            "N m s/rad",
+            0.0,
+            1e3,
+        ),
+    )
+    coulomb_n_m: list[float] | tuple[float, ...] = field(
+        default_factory=list,
+        metadata=param(
+            "Coulomb joint friction, one value for every joint or one per joint; [] = each "
+            "joint's <dynamics friction> from the URDF",
+            "N m",
+            0.0,
+            1e3,
+        ),
     )
