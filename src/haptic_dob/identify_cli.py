@@ -3,20 +3,34 @@
 Reads the joint states of a recorded session (MCAP or sqlite3; ours or ``ros2 bag record``'s;
 ``/joint_states`` alone is enough) and identifies ``m x'' + c x' + Fc sgn(x') = u`` by least
 squares (default) or by the thesis's step method (``--method step``, under a virtual spring).
-Prints a table, or one JSON line (``--json``); ``--write-yaml FILE`` writes the observer's model
-as a params file (``slide.*`` of the observer and the controller, the nodes that assume a model)
-to load after the session's config.
+With ``--urdf FILE --tip-frame F`` it identifies an arm's joint friction instead (viscous and
+Coulomb per joint, beyond the URDF's rigid body; ``haptic_dob.arm_identification``), judged on
+held-out data. Prints a table, or one JSON line (``--json``); ``--write-yaml FILE`` writes the
+model as a params file (``slide.*``, or ``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``,
+of the observer and the controller, the nodes that assume a model) to load after the session's
+config.
 """
 
 from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
+from haptic_dob.arm_identification import ArmFrictionFit
 from haptic_dob.cli import ArgumentParser, CliError, run
 from haptic_dob.identification import METHODS, IdentificationError, SlideFit
+
+
+@dataclass(frozen=True)
+class ArmSpec:
+    """The arm whose friction is identified: URDF file, tip frame, joints (empty: the chain)."""
+
+    urdf: str
+    tip_frame: str
+    joints: tuple[str, ...] = ()
 
 
 def _pm(value: float | None, std: float | None, fmt: str) -> str:
@@ -42,14 +56,54 @@ def table(fit: SlideFit, bag: str) -> str:
 MODEL_NODES = ("observer_node", "controller_node")
 
 
-def model_yaml(fit: SlideFit, bag: str) -> str:
-    """A params file that sets the assumed slide model of the observer and the controller."""
+def model_yaml(params: Mapping[str, object], what: str, bag: str) -> str:
+    """A params file that sets ``params`` of the observer's and the controller's model."""
     import yaml
 
-    head = f"# identified from {bag} by haptic-identify ({fit.method}, joint {fit.joint})\n"
-    doc = {f"/**/{n}": {"ros__parameters": fit.as_params()} for n in MODEL_NODES}
+    head = f"# identified from {bag} by haptic-identify ({what})\n"
+    doc = {f"/**/{n}": {"ros__parameters": dict(params)} for n in MODEL_NODES}
     body: str = yaml.safe_dump(doc, sort_keys=False)
     return head + body
+
+
+def arm_table(fit: ArmFrictionFit, bag: str) -> str:
+    """Each joint's friction and what it explains on the held-out part of the record."""
+    rows = [
+        f"bag {bag}: joint friction beyond the URDF's rigid body (held out: the last 30 %)",
+        "joint                viscous (N m s/rad)   Coulomb (N m)       held-out RMS (N m): "
+        "rigid -> with friction",
+    ]
+    for j in fit.joints:
+        rows.append(
+            f"{j.joint:<20} {_pm(j.viscous, j.viscous_std, '.4f'):<21} "
+            f"{_pm(j.coulomb, j.coulomb_std, '.4f'):<19} "
+            f"{j.heldout_rms_rigid:.4f} -> {j.heldout_rms:.4f}"
+        )
+    return "\n".join(rows)
+
+
+def arm_command(bag: str, topic: str, arm: ArmSpec, as_json: bool, write_yaml: str | None) -> int:
+    """Identify an arm's joint friction, print it, optionally write it as the model's."""
+    from haptic_dob.arm_identification import identify_arm_friction
+    from haptic_dob.bag.joints import read_joints
+    from haptic_dob.models import UrdfModel
+
+    rigid = UrdfModel(arm.urdf, arm.tip_frame, arm.joints or None, viscous=0.0, coulomb=0.0)
+    js = read_joints(bag, topic, rigid.joint_names)
+    try:
+        fit = identify_arm_friction(rigid, js.stamps_ns, js.position, js.effort, js.names)
+    except IdentificationError as exc:
+        raise CliError(f"{bag}: {exc}") from None
+    if as_json:
+        print(json.dumps({"bag": bag, "joints": [j.__dict__ for j in fit.joints]}))
+    else:
+        print(arm_table(fit, bag))
+    if write_yaml:
+        text = model_yaml(fit.as_params(), f"joint friction, URDF {arm.urdf}", bag)
+        Path(write_yaml).write_text(text, encoding="utf-8")
+        if not as_json:
+            print(f"model written to {write_yaml}")
+    return 0
 
 
 def command(
@@ -71,7 +125,8 @@ def command(
     else:
         print(table(fit, bag))
     if write_yaml:
-        Path(write_yaml).write_text(model_yaml(fit, bag), encoding="utf-8")
+        what = f"{fit.method}, joint {fit.joint}"
+        Path(write_yaml).write_text(model_yaml(fit.as_params(), what, bag), encoding="utf-8")
         if not as_json:
             print(f"model written to {write_yaml}")
     return 0
@@ -93,7 +148,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     p.add_argument("--json", action="store_true", help="one JSON line instead of the table")
     p.add_argument("--write-yaml", metavar="FILE", help="write the model as a params file")
+    p.add_argument(
+        "--urdf", metavar="FILE", help="an arm: identify its joint friction beyond this URDF"
+    )
+    p.add_argument("--tip-frame", help="with --urdf: the arm's end-effector frame")
+    p.add_argument(
+        "--joints", help="with --urdf: comma-separated joints (default: the chain to the tip)"
+    )
     a = p.parse_args(argv)
+    if a.urdf:
+        if not a.tip_frame:
+            p.error("--urdf needs --tip-frame")
+        joints = tuple(j for j in (a.joints or "").split(",") if j)
+        arm = ArmSpec(a.urdf, a.tip_frame, joints)
+        return run(lambda: arm_command(a.bag, a.topic, arm, a.json, a.write_yaml))
     return run(lambda: command(a.bag, a.topic, a.joint, a.method, a.json, a.write_yaml))
 
 

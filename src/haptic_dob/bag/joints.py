@@ -1,4 +1,4 @@
-"""One joint's position and effort out of a bag's ``sensor_msgs/JointState`` topic.
+"""Joints' positions and efforts out of a bag's ``sensor_msgs/JointState`` topic.
 
 Any rosbag2 bag (MCAP or sqlite3, ours or ``ros2 bag record``'s): a bag holding nothing but
 ``/joint_states`` as a driver publishes it (name, position, velocity, effort) is enough for
@@ -9,10 +9,13 @@ legitimately.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from haptic_dob.bag.bagfile import listing, open_bag, resolve_topic, topics_of
 from haptic_dob.bag.errors import BagError
@@ -20,10 +23,21 @@ from haptic_dob.bag.series import JOINT_STATE
 from haptic_dob.identification import JointRecord
 
 
-def read_joint(
-    path: str | Path, topic: str = "joint_states", joint: str | None = None
-) -> JointRecord:
-    """Stamps, positions and efforts of ``joint`` (None: the first) on ``topic`` of a bag."""
+@dataclass(frozen=True)
+class JointStates:
+    """Several joints' samples: stamps (ns), positions (N, n) and efforts over [k-1, k) (N, n)."""
+
+    stamps_ns: NDArray[np.int64]
+    names: tuple[str, ...]
+    position: NDArray[np.float64]
+    effort: NDArray[np.float64]
+
+
+def read_joints(
+    path: str | Path, topic: str = "joint_states", joints: Sequence[str] | None = None
+) -> JointStates:
+    """Stamps, positions and efforts of ``joints`` (None: every joint of the first message, in
+    its order) on ``topic`` of a bag; ``BagError`` with one line when they are not there."""
     from haptic_msgs_py.wire import TYPESTORE
 
     shown = str(path)
@@ -35,43 +49,55 @@ def read_joint(
         conns = [c for c in reader.connections if c.topic == name]
         stamps: list[int] = []
         received: list[int] = []
-        pos: list[float] = []
-        eff: list[float] = []
-        j, chosen, last_names = 0, joint, None
+        pos: list[list[float]] = []
+        eff: list[list[float]] = []
+        wanted: list[str] = list(joints or ())
+        idx: list[int] = [0]
+        last_names: list[str] | None = None
         for _conn, t, data in reader.messages(connections=conns):
             msg: Any = TYPESTORE.deserialize_cdr(data, JOINT_STATE)
             names = list(msg.name)
-            if names != last_names:  # a driver may change its joint list: look it up again
-                j, last_names = _index(names, joint, shown, name), names
-                chosen = names[j] if names else joint
-            if len(msg.position) <= j:
-                raise BagError(f"{shown}: {name} has no position for joint {chosen!r}")
-            if len(msg.effort) <= j:
+            if names != last_names:  # a driver may change its joint list: look them up again
+                wanted = wanted or names or ["joint 0"]
+                idx, last_names = _indices(names, wanted, shown, name), names
+            n = max(idx) + 1
+            if len(msg.position) < n:
+                raise BagError(f"{shown}: {name} has no position for joint {wanted[-1]!r}")
+            if len(msg.effort) < n:
                 raise BagError(
-                    f"{shown}: {name} carries no effort for joint {chosen!r}; identification "
+                    f"{shown}: {name} carries no effort for joint {wanted[0]!r}; identification "
                     "needs the applied effort (the driver's effort field)"
                 )
             st = msg.header.stamp
             stamps.append(st.sec * 1_000_000_000 + st.nanosec)
             received.append(t)
-            pos.append(float(msg.position[j]))
-            eff.append(float(msg.effort[j]))
+            pos.append([float(msg.position[i]) for i in idx])
+            eff.append([float(msg.effort[i]) for i in idx])
     if not stamps:
         raise BagError(f"{shown}: {name} holds no messages; topics: {listing(topics)}")
     if not any(stamps):  # no header stamped: the receive times
         stamps = received
     order = np.argsort(np.asarray(stamps), kind="stable")
-    return JointRecord(
+    return JointStates(
         np.asarray(stamps, np.int64)[order],
-        np.asarray(pos)[order],
-        np.asarray(eff)[order],
-        chosen or "joint 0",
+        tuple(wanted),
+        np.asarray(pos, np.float64)[order],
+        np.asarray(eff, np.float64)[order],
     )
 
 
-def _index(names: list[str], joint: str | None, shown: str, topic: str) -> int:
-    if joint is None:
-        return 0
-    if joint not in names:
-        raise BagError(f"{shown}: {topic} has no joint {joint!r}; joints: {', '.join(names)}")
-    return names.index(joint)
+def read_joint(
+    path: str | Path, topic: str = "joint_states", joint: str | None = None
+) -> JointRecord:
+    """Stamps, positions and efforts of ``joint`` (None: the first) on ``topic`` of a bag."""
+    js = read_joints(path, topic, [joint] if joint else None)
+    return JointRecord(js.stamps_ns, js.position[:, 0], js.effort[:, 0], js.names[0])
+
+
+def _indices(names: list[str], wanted: list[str], shown: str, topic: str) -> list[int]:
+    if not names:  # an unnamed driver: its joints in order
+        return list(range(len(wanted)))
+    missing = [j for j in wanted if j not in names]
+    if missing:
+        raise BagError(f"{shown}: {topic} has no joint {missing[0]!r}; joints: {', '.join(names)}")
+    return [names.index(j) for j in wanted]

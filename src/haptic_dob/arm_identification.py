@@ -1,0 +1,141 @@
+"""Joint friction of an arm from its joint states: ``tau - RNEA(q, q', q'') = b q' + Fc sgn(q')``.
+
+ROS-free (numpy/scipy/the model's pinocchio). The rigid-body part comes from the arm's model (its
+URDF's masses and inertias, friction left out); what the measured effort has beyond it is fitted
+per joint as viscous plus Coulomb friction by least squares, as the 1-DOF identification does:
+positions low-passed by a zero-phase Butterworth filter, velocity and acceleration from them
+(Savitzky-Golay), the effort of [k-1, k) centred on sample k and filtered the same way, the
+Coulomb term as the filtered sign of a lightly smoothed velocity, samples at rest left out
+(stiction is not in the model), decimated to about independent residuals.
+
+The fit uses the first ``1 - holdout`` of the record; the rest is held out: each joint reports
+the RMS of what the rigid-body model leaves unexplained there without friction and with the
+fitted friction, so the fit is judged on data it has not seen.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import signal
+
+from haptic_dob.identification import IdentificationError
+from haptic_dob.models._pinocchio import PinocchioModel
+
+Arr = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class JointFriction:
+    """One joint's fitted friction with standard errors and its held-out residuals (N m)."""
+
+    joint: str
+    viscous: float  # N m s/rad (or N s/m)
+    coulomb: float  # N m (or N)
+    viscous_std: float
+    coulomb_std: float
+    samples: int  # samples the fit used
+    heldout_rms_rigid: float  # RMS of effort - rigid-body model on held-out moving samples
+    heldout_rms: float  # the same with the fitted friction
+
+
+@dataclass(frozen=True)
+class ArmFrictionFit:
+    """Every joint's friction; ``as_params`` gives the URDF model's ``urdf.*`` overrides."""
+
+    joints: list[JointFriction]
+
+    def as_params(self) -> dict[str, list[float]]:
+        """``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``, one value per joint."""
+        return {
+            "urdf.viscous_n_m_s_per_rad": [j.viscous for j in self.joints],
+            "urdf.coulomb_n_m": [j.coulomb for j in self.joints],
+        }
+
+
+def identify_arm_friction(
+    rigid: PinocchioModel,
+    stamps_ns: NDArray[np.int64],
+    position: Arr,
+    effort: Arr,
+    names: Sequence[str],
+    cutoff_hz: float = 20.0,
+    min_speed: float = 0.02,
+    holdout: float = 0.3,
+) -> ArmFrictionFit:
+    """Fit each joint's viscous and Coulomb friction on the effort ``rigid`` leaves unexplained.
+
+    ``position`` and ``effort`` are (N, dof) in ``rigid``'s joint order (``names``); the effort of
+    sample k was applied over [k-1, k). ``min_speed`` (rad/s or m/s): slower samples are left out.
+    """
+    n, dof = position.shape
+    if dof != rigid.dof or effort.shape != position.shape:
+        raise IdentificationError(
+            f"the record has {dof} joints and efforts of shape {effort.shape}; the model has "
+            f"{rigid.dof} joints"
+        )
+    if n < 500:
+        raise IdentificationError(f"too short: {n} samples, need 500")
+    dt = float(np.median(np.diff(stamps_ns))) * 1e-9
+    if not dt > 0.0 or not np.all(np.isfinite(position)) or not np.all(np.isfinite(effort)):
+        raise IdentificationError("the stamps do not increase, or a value is not finite")
+    fs = 1.0 / dt
+    if not 0.0 < cutoff_hz < fs / 4:
+        raise IdentificationError(f"cutoff must be in (0, {fs / 4:g}) Hz, got {cutoff_hz:g}")
+    sos = signal.butter(4, cutoff_hz, fs=fs, output="sos")
+    window = max(5, int(fs / cutoff_hz) | 1)
+
+    def smooth(y: Arr) -> Arr:
+        return np.asarray(
+            signal.savgol_filter(signal.sosfiltfilt(sos, y, axis=0), window, 3, axis=0)
+        )
+
+    x = signal.sosfiltfilt(sos, position, axis=0)
+    v = signal.savgol_filter(x, window, 3, deriv=1, delta=dt, axis=0)
+    a = signal.savgol_filter(x, window, 3, deriv=2, delta=dt, axis=0)
+    u_mid = effort.copy()
+    u_mid[:-1] = 0.5 * (effort[:-1] + effort[1:])
+    u = smooth(u_mid)
+    rigid_effort = np.array([rigid.inverse_dynamics(x[k], v[k], a[k]) for k in range(n)])
+    r = u - rigid_effort  # what friction (and anything else not modelled) must explain
+    v_light = signal.savgol_filter(position, 11, 2, deriv=1, delta=dt, axis=0)
+    s = smooth(np.sign(v_light))
+    edge = 2 * window
+    split = int((1.0 - holdout) * n)
+    step = max(1, int(fs / (2.0 * cutoff_hz)))
+    out = []
+    for j, name in enumerate(names):
+        moving = signal.sosfiltfilt(sos, (np.abs(v_light[:, j]) > min_speed).astype(float)) > 0.99
+        usable = np.zeros(n, bool)
+        usable[edge:-edge] = moving[edge:-edge]
+        fit_idx = np.flatnonzero(usable[:split])[::step]
+        test_idx = np.flatnonzero(usable[split:])[::step] + split
+        if len(fit_idx) < 20 or len(test_idx) < 10:
+            raise IdentificationError(
+                f"{name}: too little motion to fit ({len(fit_idx)} usable samples faster than "
+                f"{min_speed:g}/s before the held-out part, {len(test_idx)} in it)"
+            )
+        X = np.column_stack([v[fit_idx, j], s[fit_idx, j]])
+        theta, *_ = np.linalg.lstsq(X, r[fit_idx, j], rcond=None)
+        resid = r[fit_idx, j] - X @ theta
+        sigma2 = float(resid @ resid) / max(1, len(fit_idx) - 2)
+        std = np.sqrt(np.maximum(np.diag(sigma2 * np.linalg.pinv(X.T @ X)), 0.0))
+        rt = r[test_idx, j]
+        pred = np.column_stack([v[test_idx, j], s[test_idx, j]]) @ theta
+        out.append(
+            JointFriction(
+                str(name),
+                float(theta[0]),
+                float(theta[1]),
+                float(std[0]),
+                float(std[1]),
+                len(fit_idx),
+                math.sqrt(float(np.mean(rt * rt))),
+                math.sqrt(float(np.mean((rt - pred) ** 2))),
+            )
+        )
+    return ArmFrictionFit(out)
