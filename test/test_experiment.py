@@ -173,6 +173,8 @@ def test_chapter_4_runs_hold_the_slide_in_a_spring_and_add_the_thesiss_inputs(ro
 
 
 def test_chapter_4_checks_hold_least_squares_and_the_step_method_to_their_bounds() -> None:
+    from dataclasses import replace
+
     from haptic_dob.identification import SlideFit
     from haptic_sim.experiments.ch4 import ch4_checks
     from haptic_sim.slide import SlideDeviceParams
@@ -183,11 +185,17 @@ def test_chapter_4_checks_hold_least_squares_and_the_step_method_to_their_bounds
         return SlideFit(method, "slide", m, c, fc, None, None, None, 100, None)
 
     checks = ch4_checks(
-        [fit("least_squares", 0.43, 1.31, 0.29), fit("step", 0.41, 1.5, None)], truth
+        [fit("least_squares", 0.43, 1.31, 0.29), fit("step", 0.41, 2.0, None)], truth
     )
-    assert [c.passed for c in checks] == [True, False]  # m 3.4 %, c 3.0 %, Fc 20.8 %; c 17.9 %
-    checks = ch4_checks([fit("least_squares", 0.44, 1.27, 0.24)], truth)
-    assert not checks[0].passed and "m 5.8 %" in checks[0].text
+    assert [c.passed for c in checks] == [True, True]  # m 3.4 %, c 3.0 %, Fc 20.8 %; m 1.4 %
+    assert "its c, 57 % off, takes the Coulomb friction in" in checks[1].text
+    checks = ch4_checks(
+        [fit("least_squares", 0.44, 1.27, 0.24), fit("step", 0.48, 1.3, None)], truth
+    )
+    assert [c.passed for c in checks] == [False, False] and "m 5.8 %" in checks[0].text
+    assert ch4_checks([fit("least_squares", 0.416, 1.272, 0.0)], replace(truth, coulomb_n=0.0))[
+        0
+    ].passed  # a frictionless truth: Fc compared absolutely
 
 
 def _row(mode: str, kf: float, wall: float, growth: float | None, vib: bool) -> RunAnalysis:

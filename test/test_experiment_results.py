@@ -59,6 +59,7 @@ def _every_part() -> dict[str, object]:
             ],
             {ch4.run_name(e): [0.0, 1.4] for e in (ch4.IDENTIFY, *ch4.VERIFY)},
             ch4.ch4_checks(fits, BASE.device),
+            [],
         ),
         "ch7": results.ch7_result(ch7),
         "ch6": results.ch6_result(ch6, BASE),

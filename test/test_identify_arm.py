@@ -89,6 +89,25 @@ def test_the_friction_beyond_the_urdf_is_found_and_explains_held_out_data(record
 
 
 @pytest.mark.slow
+def test_a_continuous_joint_wrapped_by_its_driver_gives_the_same_friction(record) -> None:
+    """arm3's base yaw (joint1) turned by 2.8 rad and wrapped to (-pi, pi], as a driver reports
+    a continuous joint: the yaw does not enter the dynamics, so the fit must not change beyond
+    rounding (the sign of a velocity that the encoder makes exactly 0 at rest flips with it:
+    measured 0.1 %). Without unwrapping, each wrap is a 2 pi / T velocity spike."""
+    wrapped = record.position.copy()
+    wrapped[:, 0] = np.angle(np.exp(1j * (wrapped[:, 0] + 2.8)))
+    assert np.max(np.abs(np.diff(wrapped[:, 0]))) > 6.0  # it does wrap
+    rigid = UrdfModel(ARM3, "tool")
+    plain = identify_arm_friction(
+        rigid, record.stamps_ns, record.position, record.effort, record.names
+    )
+    turned = identify_arm_friction(rigid, record.stamps_ns, wrapped, record.effort, record.names)
+    for a, b in zip(plain.joints, turned.joints, strict=True):
+        assert b.viscous == pytest.approx(a.viscous, rel=0.01)
+        assert b.coulomb == pytest.approx(a.coulomb, rel=0.01)
+
+
+@pytest.mark.slow
 def test_cli_reads_the_arms_bag_and_writes_the_friction_the_observer_loads(
     tmp_path, record
 ) -> None:

@@ -252,3 +252,35 @@ def test_observer_recovers_a_known_tip_force_on_third_party_arms(
     path, tip, start = ARMS[arm]
     err = known_force_error((ROBOTS / path).read_text(), tip, start, swing_rad)
     assert err < 0.02 * np.linalg.norm(FORCE), err
+
+
+def test_the_simulated_arm_runs_a_mimic_gripper_with_urdf_friction_and_a_tip_force() -> None:
+    """The device's simulator on arm6's right finger (a mimic joint in the chain, the URDF's
+    Coulomb friction smoothed, a tip force): it integrates, holds still under gravity
+    compensation and PD, and its potential energy is the free model's."""
+    from haptic_sim.arm import ArmDeviceParams, SimulatedArm
+
+    model = UrdfModel(ARM6, "finger_right_tip")
+    start = [*ARM6_START, 0.02]
+    dev = SimulatedArm(
+        model,
+        ArmDeviceParams(
+            initial_position=start,
+            external_force_n=(0.0, 0.0, -1.0),
+            external_force_at_s=0.1,
+            encoder_resolution_rad=0.0,
+        ),
+    )
+    assert dev._coulomb_eps.min() >= 1e-3
+    D0 = model.mass_matrix(start)
+    for _ in range(500):
+        s = dev.sample()
+        q, qd = np.array(s.q), np.array(s.qd)
+        dev.apply((model.gravity(q) + 400.0 * np.diag(D0) * (start - q) - 5.0 * qd).tolist())
+    assert np.all(np.isfinite(dev.q)) and np.max(np.abs(dev.q - start)) < 0.05
+    free_xml = ARM6.read_text().replace(
+        '<mimic joint="finger_left_joint" multiplier="1" offset="0"/>', ""
+    )
+    free = UrdfModel(free_xml, "finger_right_tip", [*model.joint_names, "finger_right_joint"])
+    q = np.array(start)
+    assert model.potential_energy(q) == pytest.approx(free.potential_energy(np.append(q, q[-1])))

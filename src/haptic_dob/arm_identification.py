@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import signal
 
-from haptic_dob.identification import IdentificationError
+from haptic_dob.identification import IdentificationError, physical
 from haptic_dob.models._pinocchio import PinocchioModel
 
 Arr = NDArray[np.float64]
@@ -94,6 +94,8 @@ def identify_arm_friction(
             signal.savgol_filter(signal.sosfiltfilt(sos, y, axis=0), window, 3, axis=0)
         )
 
+    # continuous joints a driver wraps to (-pi, pi]; no other joint jumps by pi in one sample
+    position = np.unwrap(position, axis=0)
     x = signal.sosfiltfilt(sos, position, axis=0)
     v = signal.savgol_filter(x, window, 3, deriv=1, delta=dt, axis=0)
     a = signal.savgol_filter(x, window, 3, deriv=2, delta=dt, axis=0)
@@ -129,8 +131,8 @@ def identify_arm_friction(
         out.append(
             JointFriction(
                 str(name),
-                float(theta[0]),
-                float(theta[1]),
+                physical("viscous friction", float(theta[0]), float(std[0]), str(name)),
+                physical("Coulomb friction", float(theta[1]), float(std[1]), str(name)),
                 float(std[0]),
                 float(std[1]),
                 len(fit_idx),

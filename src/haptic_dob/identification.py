@@ -69,6 +69,19 @@ class SlideFit:
         }
 
 
+def physical(name: str, value: float, std: float, where: str) -> float:
+    """A fitted friction term as a model may hold it: 0 where it is negative by less than two
+    standard errors (consistent with none), else ``IdentificationError``."""
+    if value >= 0.0:
+        return value
+    if value >= -2.0 * std:
+        return 0.0
+    raise IdentificationError(
+        f"{where}: the fit gives a negative {name} ({value:.3g} +- {std:.2g}): the record does "
+        "not separate friction from the rest (a richer excitation is needed)"
+    )
+
+
 def _check(rec: JointRecord, min_samples: int) -> float:
     n = len(rec.position)
     if n < min_samples:
@@ -134,7 +147,9 @@ def least_squares(rec: JointRecord, cutoff_hz: float = 40.0, min_speed: float = 
             f"{rec.joint}: the motion does not separate mass, damping and friction (a richer "
             "excitation is needed)"
         ) from None
-    m, c, fc = (float(t) for t in theta)
+    m = float(theta[0])
+    c = physical("viscous friction", float(theta[1]), float(std[1]), rec.joint)
+    fc = physical("Coulomb friction", float(theta[2]), float(std[2]), rec.joint)
     if not m > 0.0:
         raise IdentificationError(
             f"{rec.joint}: the fit gives a non-positive mass ({m:.3g} kg): the excitation is "
@@ -181,7 +196,9 @@ def step_response(rec: JointRecord) -> SlideFit:
         )
     ln = math.log(overshoot)
     zeta = -ln / math.sqrt(math.pi**2 + ln**2)
-    wd = math.pi / (ip * dt)  # the first peak comes half a damped period after the step
+    # x[0] is sample i0, one period after the step began (its effort is that of [i0-1, i0)):
+    # the first peak, half a damped period after the step, is (ip + 1) periods after it
+    wd = math.pi / ((ip + 1) * dt)
     wn = wd / math.sqrt(1.0 - zeta**2)
     k = abs(amplitude) / x_ss
     m = k / wn**2

@@ -135,9 +135,14 @@ class PinocchioModel(DeviceModel):
         # continuous joints: pinocchio's configuration is (cos, sin), ours the angle
         self._angles_to_config = model.nq != model.nv
         self._neutral = pin.neutral(model)
+        # pinocchio's mimic joints: computeAllTerms and computePotentialEnergy refuse them
+        self._mimic = any(
+            model.joints[i].shortname() == "JointModelMimic" for i in range(1, model.njoints)
+        )
         self.viscous = self._per_joint("viscous", viscous)
         self.coulomb = self._per_joint("coulomb", coulomb)
-        self._has_friction = bool(np.any(self.viscous > 0.0) or np.any(self.coulomb > 0.0))
+        self._has_coulomb = bool(np.any(self.coulomb > 0.0))
+        self._has_friction = bool(np.any(self.viscous > 0.0) or self._has_coulomb)
 
     def _per_joint(self, name: str, value: float | Sequence[float]) -> Vec:
         """A scalar for every joint, or one value per joint; finite and >= 0."""
@@ -210,7 +215,9 @@ class PinocchioModel(DeviceModel):
         return self._effort(pin.computeGeneralizedGravity(self._model, self._data, self._conf(q)))
 
     def _friction(self, qd: Vec) -> Vec:
-        f: Vec = self.viscous * qd + self.coulomb * np.sign(qd)
+        f: Vec = self.viscous * qd
+        if self._has_coulomb:
+            f += self.coulomb * np.sign(qd)
         return f
 
     def _bias_effort(self, q: Vec, qd: Vec) -> Vec:
@@ -248,8 +255,11 @@ class PinocchioModel(DeviceModel):
         """D, bias effort, end-effector point, its Jacobian and ``J' q'`` from one pass.
 
         One ``computeAllTerms`` (what the simulator needs at every integration stage when forces
-        act at the tip).
+        act at the tip); with mimic joints, which it refuses, the two passes it stands for.
         """
+        if self._mimic:
+            D, h = self._mass_and_bias(q, qd)
+            return (D, h, *self._tip_state(q, qd))
         m, d, fid = self._model, self._data, self._fid
         pin.computeAllTerms(m, d, self._conf(q), self._vel(qd))
         J = self._columns(pin.getFrameJacobian(m, d, fid, _LWA)[:3])
@@ -263,4 +273,8 @@ class PinocchioModel(DeviceModel):
     def potential_energy(self, q: Vec) -> float:
         """Gravitational potential energy (J) of the device at ``q`` (0 without gravity)."""
         m, d = self._model, self._data
-        return float(pin.computePotentialEnergy(m, d, self._conf(self._q(q))))
+        conf = self._conf(self._q(q))
+        if self._mimic:  # m g z of the centre of mass (gravity along -z)
+            com_z = float(pin.centerOfMass(m, d, conf)[2])
+            return float(pin.computeTotalMass(m)) * -float(m.gravity.linear[2]) * com_z
+        return float(pin.computePotentialEnergy(m, d, conf))
