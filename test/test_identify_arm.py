@@ -176,3 +176,30 @@ def test_a_short_arm_record_is_one_line(tmp_path) -> None:
     )
     assert out.returncode == 2 and "too short: 50 samples" in out.stderr, out.stderr
     assert len(out.stderr.strip().splitlines()) == 1
+
+
+def test_a_topic_that_interleaves_an_arms_and_a_grippers_states_gives_the_arms(tmp_path) -> None:
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    from haptic_dob.bag.errors import BagError
+
+    bag = tmp_path / "bag"
+    writer = Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP)
+    writer.open()
+    conn = writer.add_connection(
+        "/joint_states", "sensor_msgs/msg/JointState", typestore=wire.TYPESTORE
+    )
+    arm, gripper = wire.joint_state(["j1", "j2"], ""), wire.joint_state(["finger"], "")
+    for k in range(1, 6):
+        for msg, values in ((arm, [0.1 * k, 0.2 * k]), (gripper, [0.01])):
+            msg.header.stamp.nanosec = k * 1_000_000
+            msg.position, msg.effort = np.array(values), np.array(values) * 10.0
+            msg.velocity = np.zeros(len(values))
+            writer.write(conn, k * 1_000_000 + 3 - len(values), wire.encode(msg))  # arm first
+    writer.close()
+    js = read_joints(bag)
+    assert js.names == ("j1", "j2") and js.position.shape == (5, 2)
+    np.testing.assert_allclose(js.position[:, 1], 0.2 * np.arange(1, 6))
+    assert read_joints(bag, joints=["finger"]).position[:, 0].tolist() == [0.01] * 5
+    with pytest.raises(BagError, match="has no joint 'elbow'; joints: j1, j2"):
+        read_joints(bag, joints=["j1", "elbow"])

@@ -126,6 +126,7 @@ def test_sets_are_yaml_values_per_node() -> None:
         ("controller_node:=1", "--set needs NODE:PARAM=VALUE"),
         ("pilot_node:kf=1", "--set names unknown node 'pilot_node'"),
         ("controller_node:kf=[1", "the value is not valid YAML"),
+        ("device_node:slide.mass_kg=0.5", "the simulated slide's physics is plant.mass_kg"),
     ],
 )
 def test_a_bad_set_is_one_error(item: str, message: str) -> None:

@@ -53,3 +53,12 @@ def test_build_and_values_round_trip() -> None:
     assert values["wall.position"] == [0.0, 0.0, -0.01]
     assert build(VirtualWall, values, "wall.") == wall
     assert build(ImpedanceLaw, {"mode": "DOB", "kf": 25}) == ImpedanceLaw("DOB", 25.0)
+
+
+def test_a_range_declared_for_an_array_holds_for_each_element() -> None:
+    from haptic_dob.models.urdf import UrdfOptions
+
+    (spec,) = [s for s in specs_of(UrdfOptions, "urdf.") if s.name == "urdf.coulomb_n_m"]
+    assert spec.check([0.1, 0.2]) is None
+    assert spec.check([0.1, -0.2]) == "urdf.coulomb_n_m must be >= 0 N m, got -0.2"
+    assert spec.check([2000.0]) == "urdf.coulomb_n_m must be <= 1000 N m, got 2000"

@@ -66,6 +66,8 @@ def test_observer_and_controller_must_assume_one_model() -> None:
         SessionConfig.from_node_params(
             {"observer_node": {"slide.mass_kg": 0.45}, "controller_node": {"slide.mass_kg": 0.5}}
         )
+    with pytest.raises(ValueError, match=r"the device's slide\.axis differs"):
+        SessionConfig.from_node_params({"device_node": {"slide.axis": [0.0, 1.0, 0.0]}})
 
 
 @pytest.mark.parametrize(

@@ -2,11 +2,8 @@
 
 ROS-free (numpy/scipy/the model's pinocchio). The rigid-body part comes from the arm's model (its
 URDF's masses and inertias, friction left out); what the measured effort has beyond it is fitted
-per joint as viscous plus Coulomb friction by least squares, as the 1-DOF identification does:
-positions low-passed by a zero-phase Butterworth filter, velocity and acceleration from them
-(Savitzky-Golay), the effort of [k-1, k) centred on sample k and filtered the same way, the
-Coulomb term as the filtered sign of a lightly smoothed velocity, samples at rest left out
-(stiction is not in the model), decimated to about independent residuals.
+per joint as viscous plus Coulomb friction by least squares, with the filters the 1-DOF
+identification uses (``haptic_dob.fit_filters``).
 
 The fit uses the first ``1 - holdout`` of the record; the rest is held out: each joint reports
 the RMS of what the rigid-body model leaves unexplained there without friction and with the
@@ -21,9 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import signal
 
-from haptic_dob.identification import IdentificationError, physical
+from haptic_dob.fit_filters import IdentificationError, MotionFilters, fit, physical
 from haptic_dob.models._pinocchio import PinocchioModel
 
 Arr = NDArray[np.float64]
@@ -48,6 +44,7 @@ class ArmFrictionFit:
     """Every joint's friction; ``as_params`` gives the URDF model's ``urdf.*`` overrides."""
 
     joints: list[JointFriction]
+    holdout: float  # the part of the record held out (its end)
 
     def as_params(self) -> dict[str, list[float]]:
         """``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``, one value per joint."""
@@ -83,49 +80,28 @@ def identify_arm_friction(
     dt = float(np.median(np.diff(stamps_ns))) * 1e-9
     if not dt > 0.0 or not np.all(np.isfinite(position)) or not np.all(np.isfinite(effort)):
         raise IdentificationError("the stamps do not increase, or a value is not finite")
-    fs = 1.0 / dt
-    if not 0.0 < cutoff_hz < fs / 4:
-        raise IdentificationError(f"cutoff must be in (0, {fs / 4:g}) Hz, got {cutoff_hz:g}")
-    sos = signal.butter(4, cutoff_hz, fs=fs, output="sos")
-    window = max(5, int(fs / cutoff_hz) | 1)
-
-    def smooth(y: Arr) -> Arr:
-        return np.asarray(
-            signal.savgol_filter(signal.sosfiltfilt(sos, y, axis=0), window, 3, axis=0)
-        )
-
+    f = MotionFilters.design(dt, cutoff_hz)
     # continuous joints a driver wraps to (-pi, pi]; no other joint jumps by pi in one sample
     position = np.unwrap(position, axis=0)
-    x = signal.sosfiltfilt(sos, position, axis=0)
-    v = signal.savgol_filter(x, window, 3, deriv=1, delta=dt, axis=0)
-    a = signal.savgol_filter(x, window, 3, deriv=2, delta=dt, axis=0)
-    u_mid = effort.copy()
-    u_mid[:-1] = 0.5 * (effort[:-1] + effort[1:])
-    u = smooth(u_mid)
+    x, v, a = f.motion(position)
     rigid_effort = np.array([rigid.inverse_dynamics(x[k], v[k], a[k]) for k in range(n)])
-    r = u - rigid_effort  # what friction (and anything else not modelled) must explain
-    v_light = signal.savgol_filter(position, 11, 2, deriv=1, delta=dt, axis=0)
-    s = smooth(np.sign(v_light))
-    edge = 2 * window
+    r = f.effort(effort) - rigid_effort  # what friction (and anything not modelled) explains
+    v_light = f.light_velocity(position)
+    s = f.coulomb_term(v_light)
     split = int((1.0 - holdout) * n)
-    step = max(1, int(fs / (2.0 * cutoff_hz)))
     out = []
     for j, name in enumerate(names):
-        moving = signal.sosfiltfilt(sos, (np.abs(v_light[:, j]) > min_speed).astype(float)) > 0.99
-        usable = np.zeros(n, bool)
-        usable[edge:-edge] = moving[edge:-edge]
-        fit_idx = np.flatnonzero(usable[:split])[::step]
-        test_idx = np.flatnonzero(usable[split:])[::step] + split
+        usable = f.usable(v_light[:, j], min_speed)
+        fit_idx = np.flatnonzero(usable[:split])[:: f.step]
+        test_idx = np.flatnonzero(usable[split:])[:: f.step] + split
         if len(fit_idx) < 20 or len(test_idx) < 10:
             raise IdentificationError(
                 f"{name}: too little motion to fit ({len(fit_idx)} usable samples faster than "
                 f"{min_speed:g}/s before the held-out part, {len(test_idx)} in it)"
             )
-        X = np.column_stack([v[fit_idx, j], s[fit_idx, j]])
-        theta, *_ = np.linalg.lstsq(X, r[fit_idx, j], rcond=None)
-        resid = r[fit_idx, j] - X @ theta
-        sigma2 = float(resid @ resid) / max(1, len(fit_idx) - 2)
-        std = np.sqrt(np.maximum(np.diag(sigma2 * np.linalg.pinv(X.T @ X)), 0.0))
+        theta, std, _ = fit(
+            np.column_stack([v[fit_idx, j], s[fit_idx, j]]), r[fit_idx, j], str(name)
+        )
         rt = r[test_idx, j]
         pred = np.column_stack([v[test_idx, j], s[test_idx, j]]) @ theta
         out.append(
@@ -140,4 +116,4 @@ def identify_arm_friction(
                 math.sqrt(float(np.mean((rt - pred) ** 2))),
             )
         )
-    return ArmFrictionFit(out)
+    return ArmFrictionFit(out, holdout)

@@ -36,7 +36,7 @@ def wall_force(
     """Stage 1: the wall's force on the hand (N) at the sample's end-effector point and twist,
     plus ``excitation`` at the sample's time along the wall normal."""
     f = wall.force(position, velocity)  # type: ignore[arg-type]  # 3-sequences of floats
-    if excitation is None or not excitation.active:
+    if excitation is None:
         return f
     e = excitation.force_n(stamp_ns * 1e-9)
     n = wall.normal
@@ -83,7 +83,7 @@ class LoopCycle:
         excitation: Excitation | None = None,
     ) -> None:
         self.wall = wall
-        self.excitation = excitation
+        self.excitation = excitation if excitation is not None and excitation.active else None
         self.observer = observer
         self.join = CommandJoin(controller, period_ns, not controller.model.constant_jacobian)
 

@@ -33,7 +33,8 @@ class Excitation:
     )
     at_s: float = field(default=1.0, metadata=param("start (sample time)", "s", 0.0, 1e7))
     frequency_hz: float = field(
-        default=2.0, metadata=param("frequency of the sine", "Hz", 0.0, 1e3)
+        default=2.0,
+        metadata=param("frequency of the sine (well below the loop rate)", "Hz", 0.0, 200.0),
     )
 
     def __post_init__(self) -> None:

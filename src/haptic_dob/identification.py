@@ -20,14 +20,12 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import signal
+
+from haptic_dob.fit_filters import IdentificationError, MotionFilters, fit, physical
 
 Arr = NDArray[np.float64]
 METHODS = ("least_squares", "step")
-
-
-class IdentificationError(ValueError):
-    """The record cannot give the model (too short, no motion, no step...): one line."""
+__all__ = ["METHODS", "IdentificationError", "JointRecord", "SlideFit", "identify"]
 
 
 @dataclass(frozen=True)
@@ -69,19 +67,6 @@ class SlideFit:
         }
 
 
-def physical(name: str, value: float, std: float, where: str) -> float:
-    """A fitted friction term as a model may hold it: 0 where it is negative by less than two
-    standard errors (consistent with none), else ``IdentificationError``."""
-    if value >= 0.0:
-        return value
-    if value >= -2.0 * std:
-        return 0.0
-    raise IdentificationError(
-        f"{where}: the fit gives a negative {name} ({value:.3g} +- {std:.2g}): the record does "
-        "not separate friction from the rest (a richer excitation is needed)"
-    )
-
-
 def _check(rec: JointRecord, min_samples: int) -> float:
     n = len(rec.position)
     if n < min_samples:
@@ -97,56 +82,18 @@ def _check(rec: JointRecord, min_samples: int) -> float:
 def least_squares(rec: JointRecord, cutoff_hz: float = 40.0, min_speed: float = 2e-3) -> SlideFit:
     """Fit m, c and Fc on ``rec`` (see the module); ``cutoff_hz`` of the low-pass, ``min_speed``
     (m/s) the speed below which a sample is left out (stiction, sign of the velocity)."""
-    dt = _check(rec, 200)
-    fs = 1.0 / dt
-    if not 0.0 < cutoff_hz < fs / 4:
-        raise IdentificationError(f"cutoff must be in (0, {fs / 4:g}) Hz, got {cutoff_hz:g}")
-    sos = signal.butter(4, cutoff_hz, fs=fs, output="sos")
-    x = signal.sosfiltfilt(sos, rec.position)
-    # the effort of sample k was applied over [k-1, k): centre it on the sample like x's
-    # central derivatives (the mean of the efforts on either side of sample k)
-    u_mid = np.empty_like(rec.effort)
-    u_mid[:-1] = 0.5 * (rec.effort[:-1] + rec.effort[1:])
-    u_mid[-1] = rec.effort[-1]
-    window = max(5, int(fs / cutoff_hz) | 1)
-
-    def smooth(y: Arr) -> Arr:
-        return np.asarray(signal.savgol_filter(signal.sosfiltfilt(sos, y), window, 3))
-
-    # the same (linear) filters on every term of the equation: their lag and gain cancel,
-    # the Coulomb term included (the sign of a lightly smoothed velocity, then filtered)
-    u = smooth(u_mid)
-    v = signal.savgol_filter(x, window, 3, deriv=1, delta=dt)
-    a = signal.savgol_filter(x, window, 3, deriv=2, delta=dt)
-    v_light = signal.savgol_filter(rec.position, 11, 2, deriv=1, delta=dt)
-    s = smooth(np.sign(v_light))
-    edge = 2 * window  # filter transients at both ends
-    keep = np.zeros(len(x), bool)
-    keep[edge:-edge] = True
-    # moving samples only: at rest the friction holds anything up to Fc (not in the model)
-    moving = np.abs(v_light) > min_speed
-    keep &= signal.sosfiltfilt(sos, moving.astype(float)) > 0.99
-    step = max(1, int(fs / (2.0 * cutoff_hz)))  # about independent residuals
-    idx = np.flatnonzero(keep)[::step]
+    f = MotionFilters.design(_check(rec, 200), cutoff_hz)
+    _, v, a = f.motion(rec.position)
+    u = f.effort(rec.effort)
+    v_light = f.light_velocity(rec.position)
+    idx = np.flatnonzero(f.usable(v_light, min_speed))[:: f.step]
     if len(idx) < 20:
         raise IdentificationError(
             f"{rec.joint}: too little motion to fit ({len(idx)} usable samples moving faster "
             f"than {min_speed:g}/s); record an excitation (steps, a chirp, the hand's motion)"
         )
-    X = np.column_stack([a[idx], v[idx], s[idx]])
-    y = u[idx]
-    theta, *_ = np.linalg.lstsq(X, y, rcond=None)
-    resid = y - X @ theta
-    dof = max(1, len(idx) - 3)
-    sigma2 = float(resid @ resid) / dof
-    try:
-        cov = sigma2 * np.linalg.inv(X.T @ X)
-        std = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    except np.linalg.LinAlgError:
-        raise IdentificationError(
-            f"{rec.joint}: the motion does not separate mass, damping and friction (a richer "
-            "excitation is needed)"
-        ) from None
+    X = np.column_stack([a[idx], v[idx], f.coulomb_term(v_light)[idx]])
+    theta, std, rms = fit(X, u[idx], rec.joint)
     m = float(theta[0])
     c = physical("viscous friction", float(theta[1]), float(std[1]), rec.joint)
     fc = physical("Coulomb friction", float(theta[2]), float(std[2]), rec.joint)
@@ -165,7 +112,7 @@ def least_squares(rec: JointRecord, cutoff_hz: float = 40.0, min_speed: float = 
         float(std[1]),
         float(std[2]),
         len(idx),
-        math.sqrt(sigma2),
+        rms,
     )
 
 

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from haptic_dob.arm_identification import ArmFrictionFit
 from haptic_dob.cli import ArgumentParser, CliError, run
+from haptic_dob.fit_filters import plus_minus
 from haptic_dob.identification import METHODS, IdentificationError, SlideFit
 
 
@@ -33,19 +34,13 @@ class ArmSpec:
     joints: tuple[str, ...] = ()
 
 
-def _pm(value: float | None, std: float | None, fmt: str) -> str:
-    if value is None:
-        return "-"
-    return f"{value:{fmt}}" + (f" +- {std:{fmt}}" if std is not None else "")
-
-
 def table(fit: SlideFit, bag: str) -> str:
     """The fit as a short table (units in the row names)."""
     rows = [
         f"bag {bag}, joint {fit.joint}, method {fit.method}, {fit.samples} samples",
-        f"mass_kg              {_pm(fit.mass_kg, fit.mass_std, '.4f')}",
-        f"viscous_n_s_per_m    {_pm(fit.viscous_n_s_per_m, fit.viscous_std, '.4f')}",
-        f"coulomb_n            {_pm(fit.coulomb_n, fit.coulomb_std, '.4f')}",
+        f"mass_kg              {plus_minus(fit.mass_kg, fit.mass_std, '.4f')}",
+        f"viscous_n_s_per_m    {plus_minus(fit.viscous_n_s_per_m, fit.viscous_std, '.4f')}",
+        f"coulomb_n            {plus_minus(fit.coulomb_n, fit.coulomb_std, '.4f')}",
     ]
     if fit.rms_residual_n is not None:
         rows.append(f"rms residual (N)     {fit.rms_residual_n:.4f}")
@@ -68,15 +63,16 @@ def model_yaml(params: Mapping[str, object], what: str, bag: str) -> str:
 
 def arm_table(fit: ArmFrictionFit, bag: str) -> str:
     """Each joint's friction and what it explains on the held-out part of the record."""
+    held = round(100 * fit.holdout)
     rows = [
-        f"bag {bag}: joint friction beyond the URDF's rigid body (held out: the last 30 %)",
+        f"bag {bag}: joint friction beyond the URDF's rigid body (held out: the last {held} %)",
         "joint                viscous (N m s/rad)   Coulomb (N m)       held-out RMS (N m): "
         "rigid -> with friction",
     ]
     for j in fit.joints:
         rows.append(
-            f"{j.joint:<20} {_pm(j.viscous, j.viscous_std, '.4f'):<21} "
-            f"{_pm(j.coulomb, j.coulomb_std, '.4f'):<19} "
+            f"{j.joint:<20} {plus_minus(j.viscous, j.viscous_std, '.4f'):<21} "
+            f"{plus_minus(j.coulomb, j.coulomb_std, '.4f'):<19} "
             f"{j.heldout_rms_rigid:.4f} -> {j.heldout_rms:.4f}"
         )
     return "\n".join(rows)

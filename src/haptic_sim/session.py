@@ -113,6 +113,11 @@ class SessionConfig:
                 "the observer and the controller assume different slide models (slide.*): "
                 "a batch session runs one"
             )
+        if build(SlideParams, dev, "slide.").axis != model.axis:
+            raise ValueError(
+                "the device's slide.axis differs from the one the observer assumes: a batch "
+                "session runs one axis"
+            )
         return cls(
             loop=build(LoopSettings, dev),
             model=model,

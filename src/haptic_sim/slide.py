@@ -220,14 +220,10 @@ class SimulatedSlide:
 
     # ------------------------------------------------------------------------------------------
     def _integrate(self, u: float) -> None:
-        h, d = self.hand, self.device
-        b = d.viscous_n_s_per_m
-        fc = d.coulomb_n
-        fs = fc * d.stiction_ratio  # breakaway
-        # moving: fc + rise * exp(-v^2 / vs^2) (d.friction_n, inlined: the 10 kHz inner loop)
-        vs = d.stribeck_velocity_m_per_s
-        rise = fs - fc if vs > 0.0 else 0.0
-        inv_vs2 = 1.0 / (vs * vs) if vs > 0.0 else 0.0  # as friction_n computes them
+        h = self.hand
+        b = self.device.viscous_n_s_per_m
+        # moving: fc + rise * exp(-v^2 / vs^2) (SlideDeviceParams.friction_n, inlined)
+        fc, fs, rise, inv_vs2 = self._friction
         exp = math.exp
         kh, bh, mh = h.stiffness_n_per_m, h.damping_n_s_per_m, h.mass_kg
         inv_m = self._inv_total_mass
@@ -272,7 +268,7 @@ class SimulatedSlide:
 
     def _discretise(self) -> None:
         """Matrix exponential of the linear part over one physics step (zero-order hold input),
-        and the amplifier lag's factors over one step (end value, mean)."""
+        the friction's constants, and the amplifier lag's factors over one step (end, mean)."""
         h, d = self.hand, self.device
         M = d.mass_kg + (h.mass_kg if h.active else 0.0)  # no hand, no hand mass
         kh = h.stiffness_n_per_m if h.active else 0.0
@@ -286,6 +282,10 @@ class SimulatedSlide:
             float(E[i, j]) for i, j in ((0, 0), (0, 1), (1, 0), (1, 1), (0, 2), (1, 2))
         )
         self._inv_total_mass = 1.0 / M
+        # friction: Coulomb, breakaway, the Stribeck rise and 1 / v_s^2 (as friction_n has them)
+        fc, vs = d.coulomb_n, d.stribeck_velocity_m_per_s
+        fs = fc * d.stiction_ratio
+        self._friction = (fc, fs, fs - fc if vs > 0.0 else 0.0, 1.0 / (vs * vs) if vs else 0.0)
         tau, step = d.amplifier_lag_s, self.dt_physics
         if tau > 0.0:
             end = math.exp(-step / tau)

@@ -143,8 +143,8 @@ class StabilitySweep:
 
 
 def theory_bound(base: SessionConfig, kf: float) -> float:
-    """``2 b / (T (1 + Kf))`` (N/m) for the configured slide and rate."""
-    return 2.0 * base.model.viscous_n_s_per_m * base.loop.rate_hz / (1.0 + kf)
+    """``2 b / (T (1 + Kf))`` (N/m) for the simulated plant's viscous friction b and the rate."""
+    return 2.0 * base.device.viscous_n_s_per_m * base.loop.rate_hz / (1.0 + kf)
 
 
 def growth_at(protocol: StabilityProtocol, base: SessionConfig, stiffness: float) -> StabilityPoint:

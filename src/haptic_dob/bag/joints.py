@@ -37,10 +37,15 @@ def read_joints(
     path: str | Path, topic: str = "joint_states", joints: Sequence[str] | None = None
 ) -> JointStates:
     """Stamps, positions and efforts of ``joints`` (None: every joint of the first message, in
-    its order) on ``topic`` of a bag; ``BagError`` with one line when they are not there."""
+    its order) on ``topic`` of a bag; ``BagError`` with one line when they are not there.
+
+    Messages that do not name every wanted joint (a topic that interleaves an arm's and a
+    gripper's states) are left out; a driver that names no joints gives its joints in order.
+    """
     from haptic_msgs_py.wire import TYPESTORE
 
     shown = str(path)
+    chosen = bool(joints)
     with open_bag(path) as reader:
         topics = topics_of(reader)
         name = resolve_topic(topics, topic, "joint state", shown)
@@ -52,29 +57,34 @@ def read_joints(
         pos: list[list[float]] = []
         eff: list[list[float]] = []
         wanted: list[str] = list(joints or ())
-        idx: list[int] = [0]
+        idx: list[int] | None = None
         last_names: list[str] | None = None
+        seen: dict[str, None] = {}  # every joint named, in the order first named
         for _conn, t, data in reader.messages(connections=conns):
             msg: Any = TYPESTORE.deserialize_cdr(data, JOINT_STATE)
             names = list(msg.name)
             if names != last_names:  # a driver may change its joint list: look them up again
-                wanted = wanted or names or ["joint 0"]
-                idx, last_names = _indices(names, wanted, shown, name), names
-            n = max(idx) + 1
-            if len(msg.position) < n:
-                raise BagError(f"{shown}: {name} has no position for joint {wanted[-1]!r}")
-            if len(msg.effort) < n:
-                raise BagError(
-                    f"{shown}: {name} carries no effort for joint {wanted[0]!r}; identification "
-                    "needs the applied effort (the driver's effort field)"
-                )
+                if not wanted:
+                    wanted = names or [f"joint {i}" for i in range(len(msg.position))]
+                idx, last_names = _indices(names, wanted, chosen, shown, name), names
+                seen.update(dict.fromkeys(names))
+            if idx is None:
+                continue  # a message of other joints
+            _check_fields(msg, idx, wanted, shown, name)
             st = msg.header.stamp
             stamps.append(st.sec * 1_000_000_000 + st.nanosec)
             received.append(t)
             pos.append([float(msg.position[i]) for i in idx])
             eff.append([float(msg.effort[i]) for i in idx])
     if not stamps:
-        raise BagError(f"{shown}: {name} holds no messages; topics: {listing(topics)}")
+        if last_names is None:
+            raise BagError(f"{shown}: {name} holds no messages; topics: {listing(topics)}")
+        missing = [j for j in wanted if j not in seen]
+        if missing:
+            why = f"has no joint {missing[0]!r}"
+        else:
+            why = f"names {', '.join(wanted)} in no one message"
+        raise BagError(f"{shown}: {name} {why}; joints: {', '.join(seen)}")
     if not any(stamps):  # no header stamped: the receive times
         stamps = received
     order = np.argsort(np.asarray(stamps), kind="stable")
@@ -94,10 +104,26 @@ def read_joint(
     return JointRecord(js.stamps_ns, js.position[:, 0], js.effort[:, 0], js.names[0])
 
 
-def _indices(names: list[str], wanted: list[str], shown: str, topic: str) -> list[int]:
-    if not names:  # an unnamed driver: its joints in order
+def _indices(
+    names: list[str], wanted: list[str], chosen: bool, shown: str, topic: str
+) -> list[int] | None:
+    """Where the wanted joints are in a message naming ``names``; None when it lacks one."""
+    if not names:
+        if chosen:
+            raise BagError(f"{shown}: {topic} names no joints, so it has no joint {wanted[0]!r}")
         return list(range(len(wanted)))
-    missing = [j for j in wanted if j not in names]
-    if missing:
-        raise BagError(f"{shown}: {topic} has no joint {missing[0]!r}; joints: {', '.join(names)}")
+    if any(j not in names for j in wanted):
+        return None
     return [names.index(j) for j in wanted]
+
+
+def _check_fields(msg: Any, idx: list[int], wanted: list[str], shown: str, topic: str) -> None:
+    """A position and an effort for every wanted joint, or one line naming the first missing."""
+    for i, joint in zip(idx, wanted, strict=True):
+        if len(msg.position) <= i:
+            raise BagError(f"{shown}: {topic} has no position for joint {joint!r}")
+        if len(msg.effort) <= i:
+            raise BagError(
+                f"{shown}: {topic} carries no effort for joint {joint!r}; identification "
+                "needs the applied effort (the driver's effort field)"
+            )

@@ -56,6 +56,16 @@ def normalize_namespace(namespace: str) -> str:
     return ns
 
 
+#: parameters a node no longer takes, and what to set instead
+MOVED = {
+    ("device_node", f"slide.{name}"): (
+        f"the simulated slide's physics is plant.{name}; slide.* is the model the observer "
+        "and the controller assume"
+    )
+    for name in ("mass_kg", "viscous_n_s_per_m", "coulomb_n")
+}
+
+
 def parse_sets(items: Sequence[str]) -> dict[str, dict[str, Any]]:
     """``NODE:PARAM=VALUE`` (VALUE in YAML syntax) -> {node: {param: value}}."""
     out: dict[str, dict[str, Any]] = {}
@@ -66,6 +76,9 @@ def parse_sets(items: Sequence[str]) -> dict[str, dict[str, Any]]:
             raise CliError(f"--set needs NODE:PARAM=VALUE, got {item!r}")
         if node not in NODES:
             raise CliError(f"--set names unknown node {node!r}; nodes: {', '.join(NODES)}")
+        moved = MOVED.get((node, param))
+        if moved:
+            raise CliError(f"--set {node}:{param}: {moved}")
         try:
             value = yaml.safe_load(text)
         except yaml.YAMLError:

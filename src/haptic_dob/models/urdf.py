@@ -129,8 +129,8 @@ class UrdfOptions:
     viscous_n_m_s_per_rad: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "viscous joint friction, one value for every joint or one per joint; [] = each "
-            "joint's <dynamics damping> from the URDF",
+            "viscous joint friction (N s/m for a prismatic joint), one value for every joint or "
+            "one per joint; [] = each joint's <dynamics damping> from the URDF",
             "N m s/rad",
             0.0,
             1e3,
@@ -139,8 +139,8 @@ class UrdfOptions:
     coulomb_n_m: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "Coulomb joint friction, one value for every joint or one per joint; [] = each "
-            "joint's <dynamics friction> from the URDF",
+            "Coulomb joint friction (N for a prismatic joint), one value for every joint or one "
+            "per joint; [] = each joint's <dynamics friction> from the URDF",
             "N m",
             0.0,
             1e3,

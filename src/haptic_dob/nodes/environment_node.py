@@ -53,6 +53,7 @@ class EnvironmentNode(LoopNode):
         super().__init__(name, context=context)
         self.params = ParameterTable(self, environment_node_specs(), self._settings, self._apply)
         self.wall, self.excitation = self.params.settings
+        self._adds = self.excitation if self.excitation.active else None  # what wall_force adds
         self._pose: StampedVector | None = None
         self._twist: StampedVector | None = None
         self._period_ns = round(1e9 / self.params.values["rate_hz"])
@@ -90,6 +91,7 @@ class EnvironmentNode(LoopNode):
 
     def _apply(self, env: Environment) -> None:
         self.wall, self.excitation = env
+        self._adds = env.excitation if env.excitation.active else None
         self.get_logger().info(f"wall now {env.wall}, excitation {env.excitation.label()}")
 
     def _on_pose(self, pose: StampedVector) -> None:
@@ -106,7 +108,7 @@ class EnvironmentNode(LoopNode):
 
     def _emit(self, pose: StampedVector, twist: StampedVector) -> None:
         self._emitted_ns = pose.stamp_ns
-        force = wall_force(self.wall, pose.vector, twist.vector, self.excitation, pose.stamp_ns)
+        force = wall_force(self.wall, pose.vector, twist.vector, self._adds, pose.stamp_ns)
         self._pub.publish(StampedVector(pose.stamp_ns, force))
         self.diagnostics.tick()
 

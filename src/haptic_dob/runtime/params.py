@@ -101,6 +101,10 @@ class ParamSpec:
         for v in items:
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 return f"{self.name} must be an array of finite numbers, got {items!r}"
+        for v in items:  # a range declared for an array holds for each element
+            why = self._range(float(v))
+            if why:
+                return why
         return None
 
     def _range(self, x: float) -> str | None:

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from haptic_dob.fit_filters import plus_minus
 from haptic_dob.identification import SlideFit
 from haptic_sim.experiments.ch4 import IDENTIFY, TRACE_HZ, VERIFY, Ch4Result, run_name
 from haptic_sim.experiments.figures import pyplot, save_figure
@@ -18,16 +19,11 @@ THESIS_TABLE_4_1 = (0.416, 1.272, 0.24)
 METHOD_NAMES = {"least_squares": "least squares", "step": "step method (thesis 4.2)"}
 
 
-def _pm(v: float | None, std: float | None, spec: str) -> str:
-    return fmt(v, spec) + (f" ± {std:{spec}}" if std is not None else "")
-
-
 def _row(fit: SlideFit) -> str:
-    return (
-        f"| identified: {METHOD_NAMES[fit.method]} | {_pm(fit.mass_kg, fit.mass_std, '.4f')} | "
-        f"{_pm(fit.viscous_n_s_per_m, fit.viscous_std, '.3f')} | "
-        f"{_pm(fit.coulomb_n, fit.coulomb_std, '.3f')} |"
-    )
+    m = plus_minus(fit.mass_kg, fit.mass_std, ".4f", "–")
+    c = plus_minus(fit.viscous_n_s_per_m, fit.viscous_std, ".3f", "–")
+    fc = plus_minus(fit.coulomb_n, fit.coulomb_std, ".3f", "–")
+    return f"| identified: {METHOD_NAMES[fit.method]} | {m} | {c} | {fc} |"
 
 
 def ch4_tables(r: Ch4Result, base: SessionConfig) -> str:

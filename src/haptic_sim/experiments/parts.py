@@ -105,8 +105,8 @@ class Experiment(Generic[R]):
 
 
 def _b_rate(base: SessionConfig) -> tuple[float, float]:
-    """The slide's viscous friction (N s/m) and the loop rate (Hz): the bound's inputs."""
-    return base.model.viscous_n_s_per_m, base.loop.rate_hz
+    """The simulated plant's viscous friction (N s/m) and the loop rate (Hz): the bound's inputs."""
+    return base.device.viscous_n_s_per_m, base.loop.rate_hz
 
 
 def _kick_traces(base: SessionConfig, path: Path) -> None:
@@ -191,7 +191,7 @@ MAP: Experiment[zwidth.StabilityMap] = Experiment(
             "onset_vs_kf.png",
             "onset against Kf",
             lambda r, path, base: figures.plot_onset_vs_kf(
-                r.points, path, base.model.viscous_n_s_per_m, 1.0 / base.loop.rate_hz
+                r.points, path, base.device.viscous_n_s_per_m, 1.0 / base.loop.rate_hz
             ),
         ),
         Figure("zwidth.png", "Z-width", lambda r, path, _base: figures.plot_zwidth(r.points, path)),

@@ -162,7 +162,7 @@ def ch6_checks(onsets: list[GraphOnset], base: SessionConfig) -> list[Check]:
         if e.mode not in ("OL", "CL"):
             continue
         want = predicted_onset(e.mode, e.kf, base)
-        bnd = bound(e.mode, e.kf, base.model.viscous_n_s_per_m, base.loop.rate_hz)
+        bnd = bound(e.mode, e.kf, base.device.viscous_n_s_per_m, base.loop.rate_hz)
         ok = (
             k_on is not None
             and want is not None

@@ -90,7 +90,7 @@ def stability_map(
     protocol = StabilityProtocol()
     out = []
     T = 1.0 / base.loop.rate_hz
-    b = base.model.viscous_n_s_per_m
+    b = base.device.viscous_n_s_per_m
     for mode, kf in controllers:
         for damping in dampings:
             w = base.wall
