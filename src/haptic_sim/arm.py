@@ -10,11 +10,8 @@ reference and the external force held over each sub-step. The dynamics come from
 frictionless run of the PHANToM keeps its energy to 9e-13 J over 2 s (kinetic energy up to
 0.65 J; test_phantom).
 
-Joint friction: the model's (``b q' + Fc sgn(q')``), except that the simulated arm smooths the
-Coulomb term to ``Fc tanh(q' / eps)``: RK4 cannot integrate a sign. ``eps`` per joint is where the
-slope ``Fc / eps`` times one physics step ``h`` is half the joint's inertia (``eps = 2 Fc h /
-D_jj`` at the start pose, at least 1 mrad/s), well inside RK4's stable range; below it a joint
-creeps instead of sticking.
+Joint friction: the model's, its Coulomb sign smoothed to ``Fc tanh(q' / eps)`` (RK4 cannot
+integrate a sign; ``arm_dynamics.coulomb_smoothing`` gives eps): slower, a joint creeps.
 
 Actuators: each joint's effort is saturated on its own. The limits are ``joint_effort_limits``
 when given, else the model's own (a URDF's ``<limit effort>``) when it has them for every joint,
@@ -46,7 +43,7 @@ import numpy as np
 
 from haptic_dob.models.base import DeviceModel, Vec
 from haptic_dob.validation import positive, unit_vector, vector
-from haptic_sim.arm_dynamics import dynamics_and_tip, mass_and_bias, solve
+from haptic_sim.arm_dynamics import coulomb_smoothing, dynamics_and_tip, mass_and_bias, solve
 from haptic_sim.arm_params import ArmDeviceParams
 from haptic_sim.device import DeviceSample
 from haptic_sim.hand import HandParams, HandReference
@@ -108,7 +105,7 @@ class SimulatedArm:
             q0 = np.array(getattr(model, "home", np.zeros(n)), dtype=np.float64)
         self._dyn = mass_and_bias(model)
         self._dyn_tip = dynamics_and_tip(model)
-        self._coulomb, self._coulomb_eps = self._smoothed_coulomb(q0)
+        self._coulomb, self._coulomb_eps = coulomb_smoothing(model, self._dyn, q0, self.dt_physics)
         self.effort_limits = self._limits(q0)
         #: actuator saturation per joint (N m or N), the ``SimulatedDevice`` protocol's name
         self.max_effort = tuple(self.effort_limits.tolist())
@@ -201,15 +198,6 @@ class SimulatedArm:
             return np.array(own, dtype=np.float64)
         J = self.model._jacobian(q0)
         return cast(Vec, dev.max_force_n * np.maximum(np.linalg.norm(J, axis=0), 0.01))
-
-    def _smoothed_coulomb(self, q0: Vec) -> tuple[Vec | None, Vec]:
-        """The model's Coulomb friction (None without) and its smoothing speeds (see the module)."""
-        fc = getattr(self.model, "coulomb", None)
-        if fc is None or not np.any(np.asarray(fc) > 0.0):
-            return None, np.ones(self.dof)
-        D, _ = self._dyn(q0, np.zeros(self.dof))
-        eps = np.maximum(2.0 * np.asarray(fc) * self.dt_physics / np.diag(D), 1e-3)
-        return np.asarray(fc, dtype=np.float64), eps
 
     def _accel(self, q: Vec, v: Vec, tau: Vec, f_ext: Vec, ref: tuple[Vec, Vec, Vec] | None) -> Vec:
         """Joint acceleration; with tip forces also records (grip, J, J' q', f_ext) in ``_last``."""

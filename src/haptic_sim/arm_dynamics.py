@@ -5,7 +5,9 @@
 - ``dynamics_and_tip``: those plus the end-effector point ``p``, its Jacobian ``J`` and
   ``J' q'``, from the model's one-pass ``_dynamics_and_tip`` where it has one, else ``J' q'`` by
   central differences of ``J`` along ``q'``;
-- ``solve``: the linear solve of the accelerations, a 3x3 system by cofactors.
+- ``solve``: the linear solve of the accelerations, a 3x3 system by cofactors;
+- ``coulomb_smoothing``: the model's Coulomb friction and the speeds over which the simulated arm
+  smooths its sign (``haptic_sim.arm``).
 """
 
 from __future__ import annotations
@@ -49,6 +51,20 @@ def dynamics_and_tip(model: DeviceModel) -> DynamicsAndTip:
         return D, h, model._forward_kinematics(q), J, dJ @ v
 
     return generic
+
+
+def coulomb_smoothing(
+    model: DeviceModel, dyn: MassAndBias, q0: Vec, h: float
+) -> tuple[Vec | None, Vec]:
+    """The model's Coulomb friction (None without) and, per joint, the speed ``eps`` where the
+    slope ``Fc / eps`` times the physics step ``h`` (s) is half the joint's inertia at ``q0``
+    (at least 1 mrad/s)."""
+    fc = getattr(model, "coulomb", None)
+    if fc is None or not np.any(np.asarray(fc) > 0.0):
+        return None, np.ones(model.dof)
+    D, _ = dyn(q0, np.zeros(model.dof))
+    fc = np.asarray(fc, dtype=np.float64)
+    return fc, np.maximum(2.0 * fc * h / np.diag(D), 1e-3)
 
 
 def solve(A: Mat, b: Vec) -> Vec:
