@@ -1,7 +1,7 @@
 # haptic_dob: the two commands of the README, plus a few helpers.
 #   make demo       create .venv, install, run OL / CL / DOB at 800 N/m through the node graph
 #   make test       install if needed, run the whole test suite
-#   make reproduce  the thesis's chapters 4, 6 and 7 through the node graph, report in report/
+#   make reproduce  the thesis's experiments through the node graph, report in report/
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin

@@ -172,6 +172,21 @@ def test_chapter_4_runs_hold_the_slide_in_a_spring_and_add_the_thesiss_inputs(ro
     assert runs[-1].params["environment_node"]["excitation.frequency_hz"] == 2.0
 
 
+def test_chapter_5_runs_record_the_estimate_the_sensor_and_the_true_force(root) -> None:
+    from haptic_sim.experiments import ch5
+
+    runs = ch5.chapter5_runs(root / "config" / "slide_sim.yaml")
+    assert [r.name for r in runs] == ["ch5_free", "ch5_wall800"]
+    for r in runs:
+        assert {"wrench_estimate", "wrench_measured", "sim/hand_wrench"} <= set(
+            r.params["recorder_node"]["topics"]
+        )
+        assert "observer_node" in r.params["device_node"]["wait_for"]
+        assert r.params["controller_node"]["mode"] == "OL"
+    assert runs[0].params["environment_node"]["stiffness_n_per_m"] == 0.0
+    assert runs[0].params["device_node"]["hand.offset_m"] == 0.0
+
+
 def test_chapter_4_checks_hold_least_squares_and_the_step_method_to_their_bounds() -> None:
     from dataclasses import replace
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from haptic_dob.identification import SlideFit
-from haptic_sim.experiments import ch4, dob, report, results
+from haptic_sim.experiments import ch4, ch5, dob, report, results
 from haptic_sim.experiments.jsonio import from_json, to_json
 from haptic_sim.experiments.parts import (
     EXPERIMENTS,
@@ -60,6 +60,9 @@ def _every_part() -> dict[str, object]:
             {ch4.run_name(e): [0.0, 1.4] for e in (ch4.IDENTIFY, *ch4.VERIFY)},
             ch4.ch4_checks(fits, BASE.device),
             [],
+        ),
+        "ch5": ch5.Ch5Result(
+            [ch5.ObserverRun("ch5_free", 0.0, 0.05, 0.06, 0.01, 0.0, [0.1], [0.1], [0.1])]
         ),
         "ch7": results.ch7_result(ch7),
         "ch6": results.ch6_result(ch6, BASE),
@@ -169,7 +172,7 @@ def test_a_run_analysis_takes_haptic_analyze_figures_by_name() -> None:
 
 
 def test_the_table_names_each_part_and_figure_once() -> None:
-    assert len(set(PARTS)) == len(PARTS) == 6 and QUICK_PARTS == ["ch7"]
+    assert len(set(PARTS)) == len(PARTS) == 7 and QUICK_PARTS == ["ch7"]
     files = [f.file for e in EXPERIMENTS for f in e.figures]
     assert len(set(files)) == len(files)
 

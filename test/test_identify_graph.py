@@ -1,4 +1,4 @@
-"""Identification through the node graph (thesis ch. 4): the model comes from our own bags.
+"""Identification through the node graph (thesis ch. 4) and the observer against the sensor (5.3).
 
 ``haptic-experiment --parts ch4`` holds the simulated slide (stiction and an amplifier lag the
 model leaves out) in the 80 N/m spring, adds the thesis's 2.4 N step, records the bag; least
@@ -29,7 +29,7 @@ def test_the_graph_bag_gives_the_plants_model_and_the_observer_loads_it(
 ) -> None:
     out = tmp_path / "report"
     run = subprocess.run(
-        [tool("haptic-experiment"), "--parts", "ch4", "--out", str(out)],
+        [tool("haptic-experiment"), "--parts", "ch4,ch5", "--out", str(out)],
         capture_output=True,
         text=True,
         timeout=600,
@@ -46,6 +46,14 @@ def test_the_graph_bag_gives_the_plants_model_and_the_observer_loads_it(
     for p in results["predictions"]:
         if p["method"] == "least_squares":
             assert p["rms_error_mm"] < 0.5, p["excitation"]
+
+    # thesis 5.3: the observer against the force sensor and the true force, as recorded
+    # (lockstep: the same numbers on any machine; measured 0.401 / 0.411 and 0.224 / 0.229 N)
+    free, wall = json.loads((out / "results.json").read_text())["results"]["ch5"]["runs"]
+    assert free["rms_estimate_vs_sensor_n"] < 0.45 and free["rms_estimate_vs_true_n"] < 0.45
+    assert wall["rms_estimate_vs_sensor_n"] < 0.25 and wall["rms_estimate_vs_true_n"] < 0.25
+    assert free["clipped_pct"] == wall["clipped_pct"] == 0.0
+    assert free["rms_sensor_vs_true_n"] < 0.02 and wall["rms_sensor_vs_true_n"] < 0.02
 
     # the lockstep graph with its excitation is the batch run, to the bit
     run_dir = out / "runs" / "ch4_step_2p4"

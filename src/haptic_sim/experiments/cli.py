@@ -1,9 +1,11 @@
-"""``haptic-experiment``: the thesis's chapters 4, 6 and 7 through the node graph, and a report.
+"""``haptic-experiment``: the thesis's experiments through the node graph, and a report.
 
 Parts (``--parts``, all by default):
 
 - ``ch4``: identification (a 2.4 N step under an 80 N/m spring) and model verification (1.6 N and
   3.2 N steps, a 0.6 N 2 Hz sine) through the node graph, recorded and identified from the bags;
+- ``ch5``: thesis 5.3, the observer's estimate against the force sensor in free space and against
+  an 800 N/m wall, through the node graph;
 - ``ch7``: transparency, OL / CL Kf=2 / DOB Kf=1 / DOB Kf=25 on walls of 80-2400 N/m, 40 s of
   semi-random hand motion each, run through the node graph in lockstep and recorded;
 - ``ch6``: vibration onset through the node graph (push-and-hold protocol, pulse response);
@@ -144,8 +146,11 @@ def run_graph(
         raise CliError(str(exc).splitlines()[0] + " (see its launch.log)") from None
     timing["graph_runs"] = time.monotonic() - t0
     t0 = time.monotonic()
+    analysed = [r for _, job, rs in planned if job.analyse for r in rs]
     with ProcessPoolExecutor(s.batch_workers) as pool:
-        rows = list(pool.map(results.analyse_run, [s.root] * len(runs), runs))
+        figures = pool.map(results.analyse_run, [s.root] * len(analysed), analysed)
+        done = {r.name: a for r, a in zip(analysed, figures, strict=True)}
+    rows = [done.get(r.name) or results.unanalysed(s.root, r) for r in runs]
     timing["analysis"] = time.monotonic() - t0
     _say(f"analysed {len(rows)} bags ({timing['analysis']:.0f} s)")
     out: dict[str, Any] = {}

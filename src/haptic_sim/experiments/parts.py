@@ -19,6 +19,8 @@ from typing import Any, Generic, TypeVar
 from haptic_sim.experiments import (
     ch4,
     ch4_report,
+    ch5,
+    ch5_report,
     discussion,
     dob,
     figures,
@@ -48,6 +50,7 @@ class GraphJob(Generic[R]):
 
     runs: Callable[[Path, int, bool], list[GraphRun]]  # (base config file, seed, quick)
     collect: Callable[[list[RunAnalysis], SessionConfig], R]  # the runs' analyses, in order
+    analyse: bool = True  # False: the part reads its bags itself (no haptic-analyze figures)
 
 
 @dataclass(frozen=True)
@@ -118,7 +121,7 @@ def _kick_traces(base: SessionConfig, path: Path) -> None:
 CH4: Experiment[ch4.Ch4Result] = Experiment(
     part="ch4",
     result_type=ch4.Ch4Result,
-    job=GraphJob(ch4.chapter4_runs, ch4.ch4_result),
+    job=GraphJob(ch4.chapter4_runs, ch4.ch4_result, analyse=False),
     heading="Chapter 4: identification and model verification through the node graph",
     intro="The graph holds the simulated slide in an 80 N/m two-sided virtual spring (OL, no "
     "hand) while the environment adds a known force: the thesis's 2.4 N step to identify the "
@@ -132,6 +135,18 @@ CH4: Experiment[ch4.Ch4Result] = Experiment(
     notes=lambda r: [ch4_report.ch4_notes(r)],
     checks=lambda r: r.checks,
     console=ch4_report.ch4_console,
+)
+CH5: Experiment[ch5.Ch5Result] = Experiment(
+    part="ch5",
+    result_type=ch5.Ch5Result,
+    job=GraphJob(ch5.chapter5_runs, ch5.ch5_result, analyse=False),
+    heading="Thesis section 5.3: the observer against the force sensor",
+    intro="The observer runs beside an OL loop (the model it assumes, its output clipped to "
+    "4 N as the thesis clipped it) while the semi-random hand moves the slide in free space, "
+    "then pushes into an 800 N/m wall; each session is a bag.",
+    body=lambda r, base: [ch5_report.ch5_table(r, base)],
+    figures=(Figure("ch5_observer.png", "thesis section 5.3", ch5_report.plot_ch5),),
+    console=ch5_report.ch5_console,
 )
 CH7: Experiment[Ch7Result] = Experiment(
     part="ch7",
@@ -231,7 +246,7 @@ PHANTOM: Experiment[phantom.PhantomResult] = Experiment(
     figures=(Figure("thesis_5_2_1.png", "5.2.1"), Figure("thesis_5_2_2.png", "5.2.2")),
 )
 #: the parts in the report's order
-EXPERIMENTS: tuple[Experiment[Any], ...] = (CH4, CH7, CH6, MAP, DOB, PHANTOM)
+EXPERIMENTS: tuple[Experiment[Any], ...] = (CH4, CH5, CH7, CH6, MAP, DOB, PHANTOM)
 PARTS: tuple[str, ...] = tuple(e.part for e in EXPERIMENTS)
 QUICK_PARTS: list[str] = [e.part for e in EXPERIMENTS if e.quick]
 

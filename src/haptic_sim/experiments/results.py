@@ -52,6 +52,12 @@ def analyse_run(root: Path, run: GraphRun) -> RunAnalysis:
     return RunAnalysis.from_segment(run.cell, run.name, len(segments), seg)
 
 
+def unanalysed(root: Path, run: GraphRun) -> RunAnalysis:
+    """A run whose part reads its bag itself: its cell and its bag, no figures."""
+    c = run.cell
+    return RunAnalysis(c.part, c.mode, c.kf, c.wall, run.name, 0, str(bag_path(root, run)))
+
+
 def ch7_grid(
     rows: list[RunAnalysis],
 ) -> tuple[list[tuple[str, float]], list[float], dict[CellKey, RunAnalysis]]:
