@@ -149,7 +149,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     p.add_argument("--tip-frame", help="with --urdf: the arm's end-effector frame")
     p.add_argument(
-        "--joints", help="with --urdf: comma-separated joints (default: the chain to the tip)"
+        "--joints",
+        help="with --urdf: comma-separated joints (default: the chain to the tip); the chain's "
+        "other joints are taken as still at zero",
     )
     a = p.parse_args(argv)
     if a.urdf:
