@@ -1,30 +1,44 @@
 """Identification of the 1-DOF device model ``m x'' + c x' + Fc sgn(x') = u`` from a record.
 
 ROS-free (numpy/scipy); the input is what a driver's ``joint_states`` carries: the encoder
-position of each sample k and the effort applied over [k-1, k). Two methods (thesis ch. 4.2):
+position of each sample k and the effort applied over [k-1, k). The methods (thesis ch. 4.2):
 
 - ``least_squares`` (default), on any excitation with motion (steps, chirps, a hand's motion):
   position low-passed by a zero-phase Butterworth filter, velocity and acceleration its
   derivatives (Savitzky-Golay), the effort filtered the same way, then ``[a, v, sgn v] theta =
   u`` over the samples that move (``|v| > min_speed``), decimated to about one sample per
-  filter time constant so that the standard errors are not those of correlated residuals.
-- ``step``, the thesis's method: under a virtual spring, a force step A: stiffness ``k = A /
-  x_ss``, damping ratio from the overshoot, natural frequency from the time to the first peak,
-  ``m = k / wn^2``, ``c = 2 zeta sqrt(k m)``; Coulomb friction is not identified.
+  filter time constant so that the standard errors are not those of correlated residuals. A
+  Stribeck term ``sgn(v) exp(-(v/vs)^2)`` (the best ``vs`` of a grid, kept where significant)
+  takes the friction above Fc at low speed, which Fc and c would otherwise absorb; the model
+  returned leaves it out.
+- ``step``, the thesis's method: under a virtual spring, a force step A; the swings' extrema,
+  the natural frequency from their timing, ``m = k / wn^2``, ``c = 2 zeta sqrt(k m)``. Where the
+  effort holds the spring (``u = b - k x``, a rendered spring: the thesis's case), k and the
+  equilibrium come from it, and the swings' decay gives both the damping ratio (a ratio per
+  half swing) and Coulomb friction (it moves each half swing's equilibrium by Fc/k against the
+  motion: a constant decrement); the spring, held over each period, lags half a period, and
+  the ``k T / 2`` of damping it takes is added back. Without a spring in the effort, the
+  thesis's formulas.
+- ``thesis_step``, the thesis's formulas verbatim: ``k = A / x_ss``, the damping ratio from the
+  first overshoot, the natural frequency from the time to the first peak, no Coulomb friction
+  (which then reads as damping).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import signal
 
 from haptic_dob.fit_filters import IdentificationError, MotionFilters, fit, physical
 
 Arr = NDArray[np.float64]
-METHODS = ("least_squares", "step")
+METHODS = ("least_squares", "step", "thesis_step")
+#: the Stribeck velocities (m/s) tried by least squares, a term ``sgn(v) exp(-(v/vs)^2)`` each
+STRIBECK_GRID_M_PER_S = np.geomspace(1e-3, 3e-2, 15)
 __all__ = ["METHODS", "IdentificationError", "JointRecord", "SlideFit", "identify"]
 
 
@@ -94,6 +108,11 @@ def least_squares(rec: JointRecord, cutoff_hz: float = 40.0, min_speed: float = 
         )
     X = np.column_stack([a[idx], v[idx], f.coulomb_term(v_light)[idx]])
     theta, std, rms = fit(X, u[idx], rec.joint)
+    for vs in STRIBECK_GRID_M_PER_S:  # friction above Fc at low speed, which Fc must not absorb
+        fall = f.smooth(np.sign(v_light) * np.exp(-((v_light / vs) ** 2)))[idx]
+        th, sd, r = fit(np.column_stack([X, fall]), u[idx], rec.joint)
+        if r < rms and th[3] > 2.0 * sd[3]:
+            theta, std, rms = th, sd, r
     m = float(theta[0])
     c = physical("viscous friction", float(theta[1]), float(std[1]), rec.joint)
     fc = physical("Coulomb friction", float(theta[2]), float(std[2]), rec.joint)
@@ -116,8 +135,60 @@ def least_squares(rec: JointRecord, cutoff_hz: float = 40.0, min_speed: float = 
     )
 
 
-def step_response(rec: JointRecord) -> SlideFit:
-    """The thesis's step method on the largest effort step of ``rec`` (see the module)."""
+def _turning_points(x: Arr, tol: float, rest: int) -> tuple[list[int], bool]:
+    """Indices of the alternating extrema of ``x`` (a max first), each confirmed by a retreat of
+    more than ``tol``; the last swing's end too when ``x`` moves less than ``tol`` over its last
+    ``rest`` samples (the swing ended at rest: then True)."""
+    points: list[int] = []
+    rising, best = True, 0
+    for i in range(1, len(x)):
+        if (x[i] > x[best]) == rising and x[i] != x[best]:
+            best = i
+        elif abs(x[best] - x[i]) > tol:
+            points.append(best)
+            rising, best = not rising, i
+    at_rest = float(np.ptp(x[-rest:])) < tol
+    if at_rest and best < len(x) - rest and (not points or abs(x[best] - x[points[-1]]) > tol):
+        return [*points, best], True
+    return points, False
+
+
+def _peak_time(x: Arr, smooth: Arr, i: int, half: int, top: bool, first: bool) -> float:
+    """The time (samples) of the extreme of the raw ``x`` near index ``i`` of ``smooth`` (within
+    ``half`` samples; a maximum when ``top``): the middle of the samples that reach it within the
+    noise (the zero-phase filter shifts a peak whose sides curve differently), or the first of
+    them when ``first`` (where the motion stopped)."""
+    lo, hi = max(0, i - half), min(len(x), i + half + 1)
+    w = x[lo:hi] if top else -x[lo:hi]
+    noise = float(np.std(np.diff(x[lo:hi], 2))) / math.sqrt(6.0)  # of white noise on x
+    at = np.flatnonzero(w >= w.max() - 2.0 * noise - 1e-12)
+    return lo + float(at[0] if first else np.mean(at))
+
+
+def _spring_in_effort(x: Arr, u: Arr) -> tuple[float, float] | None:
+    """The virtual spring the effort holds, ``u[j] = b - k x[j-1]`` (the effort of [j-1, j) is
+    the command computed at sample j-1): ``(k, x_eq = b / k)``, or None when the effort is not
+    such a spring (R^2 < 0.99, or k <= 0)."""
+    X = np.column_stack([np.ones(len(x) - 1), x[:-1]])
+    theta, *_ = np.linalg.lstsq(X, u[1:], rcond=None)
+    resid = u[1:] - X @ theta
+    k = -float(theta[1])
+    spread = float(np.var(u[1:]))
+    if not k > 0.0 or spread == 0.0 or float(np.var(resid)) > 0.01 * spread:
+        return None
+    return k, float(theta[0]) / k
+
+
+def _over_damped(joint: str) -> str:
+    return (
+        f"{joint}: the step response does not overshoot (over-damped); the step method needs an "
+        "under-damped response (a stiffer spring), or use least squares"
+    )
+
+
+def step_response(rec: JointRecord, thesis: bool = False) -> SlideFit:
+    """The step method on the largest effort step of ``rec``: from the swings' decay, or by the
+    thesis's formulas verbatim when ``thesis`` (see the module)."""
     dt = _check(rec, 100)
     jumps = np.abs(np.diff(rec.effort))
     i0 = int(np.argmax(jumps)) + 1  # first sample whose effort includes the step
@@ -127,36 +198,69 @@ def step_response(rec: JointRecord) -> SlideFit:
     x0 = float(np.mean(rec.position[max(0, i0 - 20) : i0]))
     nxt = np.flatnonzero(jumps[i0:] > 0.5 * abs(amplitude))  # the next step ends the window
     end = i0 + int(nxt[0]) if len(nxt) else len(rec.position)
-    x = (rec.position[i0:end] - x0) * math.copysign(1.0, amplitude)
+    sign = math.copysign(1.0, amplitude)
+    x = (rec.position[i0:end] - x0) * sign
     if len(x) < 50:
         raise IdentificationError(f"{rec.joint}: the step's response is too short")
     tail = x[int(0.8 * len(x)) :]
     x_ss = float(np.mean(tail))
     if not x_ss > 0.0:
         raise IdentificationError(f"{rec.joint}: the step moved nothing")
-    ip = int(np.argmax(x))
-    overshoot = (float(x[ip]) - x_ss) / x_ss
-    if overshoot <= 0.0 or ip == 0 or ip >= len(x) - len(tail):
-        raise IdentificationError(
-            f"{rec.joint}: the step response does not overshoot (over-damped); the step method "
-            "needs an under-damped response (a stiffer spring), or use least squares"
-        )
-    ln = math.log(overshoot)
-    zeta = -ln / math.sqrt(math.pi**2 + ln**2)
+    spring = None if thesis else _spring_in_effort(x, rec.effort[i0:end] * sign)
+    k, x_eq = spring if spring is not None else (abs(amplitude) / x_ss, x_ss)
     # x[0] is sample i0, one period after the step began (its effort is that of [i0-1, i0)):
-    # the first peak, half a damped period after the step, is (ip + 1) periods after it
-    wd = math.pi / ((ip + 1) * dt)
-    wn = wd / math.sqrt(1.0 - zeta**2)
-    k = abs(amplitude) / x_ss
+    # the step is at index -1; the extrema p_1, p_2, ... follow p_0 = 0, the rest before it
+    low = signal.butter(2, min(20.0, 0.2 / dt), fs=1.0 / dt, output="sos")  # Hz
+    smooth = signal.sosfiltfilt(low, x)
+    idx, rested = _turning_points(smooth, 0.02 * x_eq, len(tail))
+    if not idx or idx[0] >= len(x) - len(tail):
+        raise IdentificationError(_over_damped(rec.joint))
+    e = np.concatenate([[-x_eq], x[idx] - x_eq])  # each extremum's distance from equilibrium
+    if spring is not None and len(idx) >= 2:
+        # each half swing is linear about an equilibrium that Coulomb friction moves by
+        # +-Fc/k against the motion: e_{n+1} = -r e_n + (1 + r) (Fc/k) sgn(e_n)
+        A = np.column_stack([-e[:-1], np.sign(e[:-1])])
+        (r, g), *_ = np.linalg.lstsq(A, e[1:], rcond=None)
+        coulomb: float | None = k * float(g) / (1.0 + float(r))
+    elif spring is not None and rested:
+        raise IdentificationError(
+            f"{rec.joint}: the step response swung once and stopped on friction; the step "
+            "method needs two swings to tell damping from friction (a larger step), or use "
+            "least squares"
+        )
+    else:  # the thesis's: the first overshoot, no Coulomb friction
+        r, coulomb = float(-e[1] / e[0]), None
+    if not r > 0.0:
+        raise IdentificationError(_over_damped(rec.joint))
+    if not r < 1.0:
+        raise IdentificationError(
+            f"{rec.joint}: the swings of the step response do not decay geometrically (ratio "
+            f"{r:.3g}); the step method needs an under-damped linear response, or use least squares"
+        )
+    ln = math.log(r)
+    zeta = -ln / math.sqrt(math.pi**2 + ln**2)
+    # the damped half period, counted from the step at index -1, from the swings that turned
+    # (one that ended at rest stopped on friction, a little early), or from the only swing
+    half = round(0.03 / dt)
+    last = len(idx) - 1
+    times = [
+        _peak_time(x, smooth, i, half, j % 2 == 0, rested and j == last) for j, i in enumerate(idx)
+    ]
+    turned = np.asarray(times[:1] if spring is None else times[:-1] if rested else times)
+    n = np.arange(1, len(turned) + 1)
+    half_period = float(n @ (turned + 1.0) / (n @ n))  # samples
+    wn = math.pi / (half_period * dt) / math.sqrt(1.0 - zeta**2)
     m = k / wn**2
     c = 2.0 * zeta * math.sqrt(k * m)
-    return SlideFit("step", rec.joint, m, c, None, None, None, None, len(x), None)
+    if spring is not None:
+        c += 0.5 * k * dt  # the spring, held over each period, lags dt/2: -k dt/2 of damping
+    return SlideFit("step", rec.joint, m, c, coulomb, None, None, None, len(x), None)
 
 
 def identify(rec: JointRecord, method: str = "least_squares") -> SlideFit:
-    """Identify the model of ``rec`` by ``method`` (``least_squares`` or ``step``)."""
+    """Identify the model of ``rec`` by ``method`` (one of ``METHODS``)."""
     if method == "least_squares":
         return least_squares(rec)
-    if method == "step":
-        return step_response(rec)
+    if method in ("step", "thesis_step"):
+        return replace(step_response(rec, thesis=method == "thesis_step"), method=method)
     raise IdentificationError(f"method must be one of {', '.join(METHODS)}, got {method!r}")

@@ -2,7 +2,8 @@
 
 Reads the joint states of a recorded session (MCAP or sqlite3; ours or ``ros2 bag record``'s;
 ``/joint_states`` alone is enough) and identifies ``m x'' + c x' + Fc sgn(x') = u`` by least
-squares (default) or by the thesis's step method (``--method step``, under a virtual spring).
+squares (default) or by the step method under a virtual spring (``--method step``, or
+``thesis_step`` for the thesis's formulas verbatim).
 With ``--urdf FILE --tip-frame F`` it identifies an arm's joint friction instead (viscous and
 Coulomb per joint, beyond the URDF's rigid body; ``haptic_dob.arm_identification``), judged on
 held-out data. Prints a table, or one JSON line (``--json``); ``--write-yaml FILE`` writes the
@@ -34,13 +35,17 @@ class ArmSpec:
     joints: tuple[str, ...] = ()
 
 
+#: the step method's Coulomb friction where the step response could not separate it
+NO_COULOMB = "- (not separated from the damping: needs a rendered spring and two swings)"
+
+
 def table(fit: SlideFit, bag: str) -> str:
     """The fit as a short table (units in the row names)."""
     rows = [
         f"bag {bag}, joint {fit.joint}, method {fit.method}, {fit.samples} samples",
         f"mass_kg              {plus_minus(fit.mass_kg, fit.mass_std, '.4f')}",
         f"viscous_n_s_per_m    {plus_minus(fit.viscous_n_s_per_m, fit.viscous_std, '.4f')}",
-        f"coulomb_n            {plus_minus(fit.coulomb_n, fit.coulomb_std, '.4f')}",
+        f"coulomb_n            {plus_minus(fit.coulomb_n, fit.coulomb_std, '.4f', NO_COULOMB)}",
     ]
     if fit.rms_residual_n is not None:
         rows.append(f"rms residual (N)     {fit.rms_residual_n:.4f}")
@@ -140,7 +145,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--method",
         choices=METHODS,
         default="least_squares",
-        help="least_squares (any excitation, default) or step (the thesis's method)",
+        help="least_squares (any excitation, default); step (under a rendered spring: damping "
+        "and Coulomb friction from the swings' decay); thesis_step (the thesis's formulas: "
+        "the first overshoot, no Coulomb friction)",
     )
     p.add_argument("--json", action="store_true", help="one JSON line instead of the table")
     p.add_argument("--write-yaml", metavar="FILE", help="write the model as a params file")

@@ -16,7 +16,11 @@ from haptic_sim.session import SessionConfig
 
 #: the thesis's identified slide (Table 4.1)
 THESIS_TABLE_4_1 = (0.416, 1.272, 0.24)
-METHOD_NAMES = {"least_squares": "least squares", "step": "step method (thesis 4.2)"}
+METHOD_NAMES = {
+    "least_squares": "least squares",
+    "step": "step method, the swings' decay",
+    "thesis_step": "step method, the thesis's formulas (4.2)",
+}
 
 
 def _row(fit: SlideFit) -> str:
@@ -61,12 +65,14 @@ def ch4_tables(r: Ch4Result, base: SessionConfig) -> str:
 
 
 def ch4_notes(_r: Ch4Result) -> str:
-    """What the section shows and why the step method's damping is high."""
+    """What the section shows and how the step method tells friction from damping."""
     return (
-        "The step method reads the damping from the overshoot of a linear second-order "
-        "response; Coulomb friction takes energy out of every swing too, so it reads friction "
-        "as viscous damping and its c comes out high (its Fc is not identified; the thesis "
-        "estimated Fc apart). Least squares fits m, c and Fc together on the samples that move, "
+        "The step method reads the damping from the decay of the swings. Coulomb friction takes "
+        "a constant amount out of every swing (it moves each half swing's equilibrium by Fc/k "
+        "against the motion) where viscous damping takes a fixed ratio, so the swings' "
+        "amplitudes give both; from the first overshoot alone, as in the thesis, friction reads "
+        "as damping and c comes out about 1.6 times too high. Least squares fits m, c and Fc "
+        "together on the samples that move (with a Stribeck term it leaves out of the model), "
         "so stiction and the amplifier lag, which the model leaves out, are what remains in its "
         "predictions.\n"
     )
@@ -79,7 +85,7 @@ def _t(n: int) -> np.ndarray:
 def plot_identification(r: Ch4Result, path: Path, _base: SessionConfig) -> None:
     """Thesis figure 4.2: the 2.4 N step, measured and predicted by each model."""
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
     _plot_run(ax, r, run_name(IDENTIFY))
     ax.set_title(f"Identification: {IDENTIFY.label()} under the 80 N/m spring")
     save_figure(fig, path)
@@ -88,7 +94,7 @@ def plot_identification(r: Ch4Result, path: Path, _base: SessionConfig) -> None:
 def plot_verification(r: Ch4Result, path: Path, _base: SessionConfig) -> None:
     """Thesis figure 4.3: the 1.6 N and 3.2 N steps and the 0.6 N, 2 Hz sine."""
     plt = pyplot()
-    fig, axes = plt.subplots(1, len(VERIFY), figsize=(12, 3.8))
+    fig, axes = plt.subplots(1, len(VERIFY), figsize=(12, 4.6))
     for ax, e in zip(axes, VERIFY, strict=True):
         _plot_run(ax, r, run_name(e))
         ax.set_title(f"Verification: {e.label()}")
@@ -110,7 +116,7 @@ def _plot_run(ax: Any, r: Ch4Result, name: str) -> None:
     ax.set_xlabel("time (s)")
     ax.set_ylabel("position (mm)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.18))  # under the traces
 
 
 def ch4_console(r: Ch4Result) -> list[str]:
