@@ -38,6 +38,7 @@ from rclpy.utilities import try_shutdown
 
 from haptic_dob.runtime.cpu_latency import NO_REQUEST, hold, strictest
 from haptic_dob.runtime.cpus import checked_cpus, pin_process
+from haptic_dob.runtime.ros.dds_profile import use_default_profile
 from haptic_msgs_py.bus import bus_for
 
 EXECUTORS = ("events", "single")
@@ -170,6 +171,7 @@ def run_nodes(
     node's non-zero ``exit_code``, or 2 when a parameter was refused at start-up.
     """
     kind = executor or os.environ.get("HAPTIC_DOB_EXECUTOR", "events")
+    use_default_profile()
     context = Context()
     try:
         rclpy.init(

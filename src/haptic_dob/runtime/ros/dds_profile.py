@@ -1,0 +1,24 @@
+"""The Fast DDS profile the suite's processes start with, unless the user gives their own.
+
+A reliable writer repairs a lost sample when a reader answers its heartbeat, which Fast DDS sends
+every 3 s by default. Between processes on one machine, samples go through shared-memory ports
+of 512 messages; on a loaded machine a reader's port overflows now and then (two recorders beside
+the loop on 2 cores), and each loss then stalls that reader, and a lockstep run that waits for
+it, for up to 3 s. ``fastdds_profile.xml`` sets the heartbeat to 50 ms: lockstep with two
+recorders went from 0.3-0.4 to 2.6-3.1 times real time (BENCHMARKS.md). It changes nothing else
+(transports, discovery and the QoS the nodes set are Fast DDS's and ROS's defaults).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+PROFILES_ENV = "FASTRTPS_DEFAULT_PROFILES_FILE"
+PROFILE = Path(__file__).with_name("fastdds_profile.xml")
+
+
+def use_default_profile() -> str:
+    """Point Fast DDS at ``PROFILE`` unless ``FASTRTPS_DEFAULT_PROFILES_FILE`` is set (a user's
+    own profile wins); call before ``rclpy.init``. Returns the profile file in effect."""
+    return os.environ.setdefault(PROFILES_ENV, str(PROFILE))
