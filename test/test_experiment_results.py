@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from haptic_dob.identification import SlideFit
-from haptic_sim.experiments import ch4, ch5, dob, report, results
+from haptic_sim.experiments import ch4, ch5, dob, grip, report, results
 from haptic_sim.experiments.jsonio import from_json, to_json
 from haptic_sim.experiments.parts import (
     EXPERIMENTS,
@@ -79,6 +79,13 @@ def _every_part() -> dict[str, object]:
             [dob.LinearOnset(100.0, 2.0, 0.0, None)],
             [dob.GainBandwidth(2.0, 1.0, 800.0, None, 48.0)],
             [dob.MismatchCell(800.0, 25.0, m, 3.0, 30.0) for m in ("assumed", "no Coulomb")],
+        ),
+        "grip": grip.GripStudy(
+            [
+                grip.GripCell("OL", 0.0, 10.0, 6.04, 25.0, 0.85, -1.6, -1.6),
+                grip.GripCell("OL", 0.0, 5.0, 0.5, 40.0, 0.64, -3.0, -2.0),
+                grip.GripCell("CL", 2.0, 10.0, None, None, None, None, None),
+            ]
         ),
         "phantom": PhantomResult(
             [0.0, 0.012, 0.004], [0.0, 0.95, 0.49], [PhantomWallCell(1.0, 0.3, 8e-5, 0.008)]
@@ -172,7 +179,7 @@ def test_a_run_analysis_takes_haptic_analyze_figures_by_name() -> None:
 
 
 def test_the_table_names_each_part_and_figure_once() -> None:
-    assert len(set(PARTS)) == len(PARTS) == 7 and QUICK_PARTS == ["ch7"]
+    assert len(set(PARTS)) == len(PARTS) == 8 and QUICK_PARTS == ["ch7"]
     files = [f.file for e in EXPERIMENTS for f in e.figures]
     assert len(set(files)) == len(files)
 

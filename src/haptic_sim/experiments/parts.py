@@ -24,6 +24,7 @@ from haptic_sim.experiments import (
     discussion,
     dob,
     figures,
+    grip,
     phantom,
     plan,
     results,
@@ -234,6 +235,20 @@ DOB: Experiment[dob.DobStudy] = Experiment(
     ),
     differences=lambda _r: [discussion.OBSERVER_GAIN_NOT_IN_THESIS],
 )
+GRIP: Experiment[grip.GripStudy] = Experiment(
+    part="grip",
+    result_type=grip.GripStudy,
+    job=BatchJob(
+        lambda base, pool, _figs: grip.study(base, pool),
+        lambda r: f"2400 N/m against the grip: {len(r.cells)} sessions",
+    ),
+    heading="Table 7.1 at 2400 N/m against the hand's grip (batch)",
+    intro="Each controller of Table 7.1 at 2400 N/m, the chapter-7 hand with its grip's "
+    "damping swept from 10 N s/m down to 1 N s/m (40 s batch sessions, the same seed).",
+    body=lambda r, _base: [grip.grip_table(r), grip.grip_discussion(r)],
+    figures=(),
+    differences=grip.grip_difference,
+)
 PHANTOM: Experiment[phantom.PhantomResult] = Experiment(
     part="phantom",
     result_type=phantom.PhantomResult,
@@ -246,7 +261,7 @@ PHANTOM: Experiment[phantom.PhantomResult] = Experiment(
     figures=(Figure("thesis_5_2_1.png", "5.2.1"), Figure("thesis_5_2_2.png", "5.2.2")),
 )
 #: the parts in the report's order
-EXPERIMENTS: tuple[Experiment[Any], ...] = (CH4, CH5, CH7, CH6, MAP, DOB, PHANTOM)
+EXPERIMENTS: tuple[Experiment[Any], ...] = (CH4, CH5, CH7, CH6, MAP, DOB, GRIP, PHANTOM)
 PARTS: tuple[str, ...] = tuple(e.part for e in EXPERIMENTS)
 QUICK_PARTS: list[str] = [e.part for e in EXPERIMENTS if e.quick]
 
