@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from haptic_dob.identification import SlideFit
-from haptic_sim.experiments import ch4, ch5, dob, grip, report, results
+from haptic_sim.experiments import ch4, ch5, dob, report, results, sweeps
 from haptic_sim.experiments.jsonio import from_json, to_json
 from haptic_sim.experiments.parts import (
     EXPERIMENTS,
@@ -80,11 +80,10 @@ def _every_part() -> dict[str, object]:
             [dob.GainBandwidth(2.0, 1.0, 800.0, None, 48.0)],
             [dob.MismatchCell(800.0, 25.0, m, 3.0, 30.0) for m in ("assumed", "no Coulomb")],
         ),
-        "grip": grip.GripStudy(
+        "sweeps": sweeps.SweepStudy(
             [
-                grip.GripCell("OL", 0.0, 10.0, 6.04, 25.0, 0.85, -1.6, -1.6),
-                grip.GripCell("OL", 0.0, 5.0, 0.5, 40.0, 0.64, -3.0, -2.0),
-                grip.GripCell("CL", 2.0, 10.0, None, None, None, None, None),
+                sweeps.SweepCell("grip", "OL", 0.0, 10.0, 6.04, 25.0, 0.85, -1.6, -1.6, 0.0),
+                sweeps.SweepCell("force_limit", "CL", 2.0, 4.0, None, None, None, None, None, 21.0),
             ]
         ),
         "phantom": PhantomResult(

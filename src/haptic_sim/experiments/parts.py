@@ -24,10 +24,10 @@ from haptic_sim.experiments import (
     discussion,
     dob,
     figures,
-    grip,
     phantom,
     plan,
     results,
+    sweeps,
     tables,
     zwidth,
 )
@@ -235,19 +235,25 @@ DOB: Experiment[dob.DobStudy] = Experiment(
     ),
     differences=lambda _r: [discussion.OBSERVER_GAIN_NOT_IN_THESIS],
 )
-GRIP: Experiment[grip.GripStudy] = Experiment(
-    part="grip",
-    result_type=grip.GripStudy,
+SWEEPS: Experiment[sweeps.SweepStudy] = Experiment(
+    part="sweeps",
+    result_type=sweeps.SweepStudy,
     job=BatchJob(
-        lambda base, pool, _figs: grip.study(base, pool),
-        lambda r: f"2400 N/m against the grip: {len(r.cells)} sessions",
+        lambda base, pool, _figs: sweeps.study(base, pool),
+        lambda r: f"Table 7.1's off cells swept: {len(r.cells)} sessions",
     ),
-    heading="Table 7.1 at 2400 N/m against the hand's grip (batch)",
-    intro="Each controller of Table 7.1 at 2400 N/m, the chapter-7 hand with its grip's "
-    "damping swept from 10 N s/m down to 1 N s/m (40 s batch sessions, the same seed).",
-    body=lambda r, _base: [grip.grip_table(r), grip.grip_discussion(r)],
+    heading="Table 7.1's cells that stay off, against the parameter responsible (batch)",
+    intro="Each controller of Table 7.1 in the chapter-7 session (40 s, the same seed and "
+    "hand) at one wall, with one parameter swept from the chapter-7 value: the hand's grip "
+    "damping at 2400 N/m, the actuator's force limit at 80 N/m.",
+    body=lambda r, _base: [
+        sweeps.sweep_table(r, sweeps.GRIP),
+        sweeps.grip_text(r),
+        sweeps.sweep_table(r, sweeps.FORCE_LIMIT),
+        sweeps.limit_text(r),
+    ],
     figures=(),
-    differences=grip.grip_difference,
+    differences=sweeps.differences,
 )
 PHANTOM: Experiment[phantom.PhantomResult] = Experiment(
     part="phantom",
@@ -261,7 +267,7 @@ PHANTOM: Experiment[phantom.PhantomResult] = Experiment(
     figures=(Figure("thesis_5_2_1.png", "5.2.1"), Figure("thesis_5_2_2.png", "5.2.2")),
 )
 #: the parts in the report's order
-EXPERIMENTS: tuple[Experiment[Any], ...] = (CH4, CH5, CH7, CH6, MAP, DOB, GRIP, PHANTOM)
+EXPERIMENTS: tuple[Experiment[Any], ...] = (CH4, CH5, CH7, CH6, MAP, DOB, SWEEPS, PHANTOM)
 PARTS: tuple[str, ...] = tuple(e.part for e in EXPERIMENTS)
 QUICK_PARTS: list[str] = [e.part for e in EXPERIMENTS if e.quick]
 
