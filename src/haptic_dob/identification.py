@@ -208,6 +208,11 @@ def step_response(rec: JointRecord, thesis: bool = False) -> SlideFit:
         raise IdentificationError(f"{rec.joint}: the step moved nothing")
     spring = None if thesis else _spring_in_effort(x, rec.effort[i0:end] * sign)
     k, x_eq = spring if spring is not None else (abs(amplitude) / x_ss, x_ss)
+    if not x_eq > 0.0:
+        raise IdentificationError(
+            f"{rec.joint}: the effort's spring holds the slide against the step (equilibrium "
+            f"{x_eq:.3g}); not a step under a spring, use least squares"
+        )
     # x[0] is sample i0, one period after the step began (its effort is that of [i0-1, i0)):
     # the step is at index -1; the extrema p_1, p_2, ... follow p_0 = 0, the rest before it
     low = signal.butter(2, min(20.0, 0.2 / dt), fs=1.0 / dt, output="sos")  # Hz

@@ -18,6 +18,7 @@ the report shows the mechanism rather than a constant fitted to the table.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from concurrent.futures import Executor
 from dataclasses import dataclass
 
@@ -33,6 +34,17 @@ from haptic_sim.stability import law_for
 SETTLE_S = 2.0  # the hand's ramp-in, left out as the sessions' summaries leave it out
 
 
+def _grip(cfg: SessionConfig, mode: str, kf: float, damping: float) -> SessionConfig:
+    """The chapter-7 law, the hand's grip damping (N s/m) at ``damping``."""
+    law = law_for(mode, kf, cfg.law.max_force_n)
+    return cfg.replace(law=law, hand__damping_n_s_per_m=damping)
+
+
+def _force_limit(cfg: SessionConfig, mode: str, kf: float, limit: float) -> SessionConfig:
+    """The law's and the actuator's force limit (N) at ``limit``."""
+    return cfg.replace(law=law_for(mode, kf, limit), device__max_force_n=limit)
+
+
 @dataclass(frozen=True)
 class Sweep:
     """One parameter swept at one wall for every controller of Table 7.1."""
@@ -41,23 +53,21 @@ class Sweep:
     wall_n_per_m: float
     parameter: str  # with its unit
     values: tuple[float, ...]  # the first is the chapter-7 session's
+    apply: Callable[[SessionConfig, str, float, float], SessionConfig]  # (cfg, mode, Kf, value)
 
     def config(self, base: SessionConfig, mode: str, kf: float, value: float) -> SessionConfig:
         """The chapter-7 session at this wall with the parameter at ``value``."""
         offset, amplitude = reference_for_force(self.wall_n_per_m, base.hand.stiffness_n_per_m)
-        cfg = base.replace(
+        at_wall = base.replace(
             wall__stiffness_n_per_m=self.wall_n_per_m,
             hand__offset_m=offset,
             hand__amplitude_m=amplitude,
         )
-        if self.name == "grip":
-            cfg = cfg.replace(hand__damping_n_s_per_m=value)
-            return cfg.replace(law=law_for(mode, kf, base.law.max_force_n))
-        return cfg.replace(law=law_for(mode, kf, value), device__max_force_n=value)
+        return self.apply(at_wall, mode, kf, value)
 
 
-GRIP = Sweep("grip", 2400.0, "grip damping (N s/m)", (10.0, 5.0, 3.0, 2.0, 1.0))
-FORCE_LIMIT = Sweep("force_limit", 80.0, "force limit (N)", (4.0, 8.0, 16.0, 64.0))
+GRIP = Sweep("grip", 2400.0, "grip damping (N s/m)", (10.0, 5.0, 3.0, 2.0, 1.0), _grip)
+FORCE_LIMIT = Sweep("force_limit", 80.0, "force limit (N)", (4.0, 8.0, 16.0, 64.0), _force_limit)
 SWEEPS = (GRIP, FORCE_LIMIT)
 
 
