@@ -9,7 +9,12 @@ from pathlib import Path
 
 import pytest
 
-from haptic_dob.runtime.ros.dds_profile import PROFILE, PROFILES_ENV, use_default_profile
+from haptic_dob.runtime.ros.dds_profile import (
+    NEWER_PROFILES_ENV,
+    PROFILE,
+    PROFILES_ENV,
+    use_default_profile,
+)
 from rosgraph import isolated_env
 
 # a node process's start: the profile chosen, then a node with a reliable writer
@@ -27,14 +32,21 @@ rclpy.shutdown()
 
 
 def test_the_suites_profile_applies_unless_the_user_gives_one(monkeypatch) -> None:
-    monkeypatch.delenv(PROFILES_ENV, raising=False)
+    for name in (PROFILES_ENV, NEWER_PROFILES_ENV):  # set, then removed: restored after the test
+        monkeypatch.setenv(name, "x")
+        monkeypatch.delenv(name)
     assert use_default_profile() == str(PROFILE) == os.environ[PROFILES_ENV]
     monkeypatch.setenv(PROFILES_ENV, "/somewhere/lab_profile.xml")
     assert use_default_profile() == "/somewhere/lab_profile.xml"
+    monkeypatch.delenv(PROFILES_ENV)
+    monkeypatch.setenv(NEWER_PROFILES_ENV, "/somewhere/fastdds3_profile.xml")
+    assert use_default_profile() == "/somewhere/fastdds3_profile.xml"
+    assert PROFILES_ENV not in os.environ
 
 
 def _start(profile: Path | None) -> subprocess.CompletedProcess[str]:
-    env = {k: v for k, v in isolated_env().items() if k != PROFILES_ENV}
+    env = {k: v for k, v in isolated_env().items() if k not in (PROFILES_ENV, NEWER_PROFILES_ENV)}
+    env["RMW_IMPLEMENTATION"] = "rmw_fastrtps_cpp"  # the profile is Fast DDS's
     if profile is not None:
         env[PROFILES_ENV] = str(profile)
     return subprocess.run(

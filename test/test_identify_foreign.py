@@ -3,7 +3,8 @@
 LuGre friction (stiction, a Stribeck fall-off, presliding and micro-damping), an amplifier lag,
 a 1 um encoder, parameters drawn from a seed and not passed on; the bags hold nothing but
 ``/joint_states``, as ``ros2 bag record`` of a driver would, in both storages. Least squares must
-find m and c within 5 % and Fc within 25 %, the step method within 15 % (issue 15).
+find m and c within 5 % and Fc within 25 %, the step method m and c within 15 % and Fc within
+25 % (issue 15).
 """
 
 from __future__ import annotations
@@ -42,7 +43,9 @@ def _identify(capsys: pytest.CaptureFixture[str], bag: Path, *args: str) -> dict
 @pytest.mark.parametrize(
     ("seed", "storage"), [(0, "mcap"), (1, "sqlite3"), (2, "mcap"), (5, "sqlite3")]
 )
-def test_thesis_step_bag_of_a_foreign_slide(tmp_path, capsys, seed: int, storage: str) -> None:
+def test_the_thesis_2p4_n_step_bag_of_a_foreign_slide(
+    tmp_path, capsys, seed: int, storage: str
+) -> None:
     """The thesis's 2.4 N step under the 80 N/m spring, identified both ways."""
     truth = ForeignSlide.draw(seed)
     rec = _record(truth, lambda t: 2.4 if t >= 1.0 else 0.0, 5.0)

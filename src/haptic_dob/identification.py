@@ -16,9 +16,10 @@ position of each sample k and the effort applied over [k-1, k). The methods (the
   effort holds the spring (``u = b - k x``, a rendered spring: the thesis's case), k and the
   equilibrium come from it, and the swings' decay gives both the damping ratio (a ratio per
   half swing) and Coulomb friction (it moves each half swing's equilibrium by Fc/k against the
-  motion: a constant decrement); the spring, held over each period, lags half a period, and
-  the ``k T / 2`` of damping it takes is added back. Without a spring in the effort, the
-  thesis's formulas.
+  motion: a constant decrement); the spring, held over each sample period T, lags T / 2, and
+  the ``k T / 2`` of damping that lag takes is added back. It needs two swings (one that stops
+  on friction or is cut short is refused). Without a spring in the effort, the thesis's
+  formulas.
 - ``thesis_step``, the thesis's formulas verbatim: ``k = A / x_ss``, the damping ratio from the
   first overshoot, the natural frequency from the time to the first peak, no Coulomb friction
   (which then reads as damping).
@@ -27,7 +28,7 @@ position of each sample k and the effort applied over [k-1, k). The methods (the
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,6 +38,7 @@ from haptic_dob.fit_filters import IdentificationError, MotionFilters, fit, phys
 
 Arr = NDArray[np.float64]
 METHODS = ("least_squares", "step", "thesis_step")
+OVERSHOOT_MIN = 0.02  # of the step: a smaller first overshoot is noise, not a swing
 #: the Stribeck velocities (m/s) tried by least squares, a term ``sgn(v) exp(-(v/vs)^2)`` each
 STRIBECK_GRID_M_PER_S = np.geomspace(1e-3, 3e-2, 15)
 __all__ = ["METHODS", "IdentificationError", "JointRecord", "SlideFit", "identify"]
@@ -70,7 +72,8 @@ class SlideFit:
     viscous_std: float | None
     coulomb_std: float | None
     samples: int  # samples the fit used
-    rms_residual_n: float | None  # of the effort the fitted model explains (least squares)
+    rms_residual_n: float | None  # of the effort the fitted terms leave (least squares; with
+    # the Stribeck term where it was kept)
 
     def as_params(self) -> dict[str, float]:
         """The ``slide.*`` parameters of the observer's model (Coulomb 0 when not identified)."""
@@ -110,7 +113,10 @@ def least_squares(rec: JointRecord, cutoff_hz: float = 40.0, min_speed: float = 
     theta, std, rms = fit(X, u[idx], rec.joint)
     for vs in STRIBECK_GRID_M_PER_S:  # friction above Fc at low speed, which Fc must not absorb
         fall = f.smooth(np.sign(v_light) * np.exp(-((v_light / vs) ** 2)))[idx]
-        th, sd, r = fit(np.column_stack([X, fall]), u[idx], rec.joint)
+        try:
+            th, sd, r = fit(np.column_stack([X, fall]), u[idx], rec.joint)
+        except IdentificationError:  # this vs does not separate from Fc: try the next
+            continue
         if r < rms and th[3] > 2.0 * sd[3]:
             theta, std, rms = th, sd, r
     m = float(theta[0])
@@ -147,10 +153,18 @@ def _turning_points(x: Arr, tol: float, rest: int) -> tuple[list[int], bool]:
         elif abs(x[best] - x[i]) > tol:
             points.append(best)
             rising, best = not rising, i
-    at_rest = float(np.ptp(x[-rest:])) < tol
-    if at_rest and best < len(x) - rest and (not points or abs(x[best] - x[points[-1]]) > tol):
-        return [*points, best], True
-    return points, False
+    if float(np.ptp(x[-rest:])) >= tol:
+        return points, False
+    # at rest: where the last swing stopped, before the resting tail (whose noise or creep
+    # would otherwise move the extreme into it)
+    start, stop = (points[-1] if points else 0), len(x) - rest
+    if stop <= start:
+        return points, False
+    seg = x[start:stop] if rising else -x[start:stop]
+    end = start + int(np.argmax(seg))
+    if points and abs(x[end] - x[points[-1]]) <= tol:
+        return points, False
+    return [*points, end], True
 
 
 def _peak_time(x: Arr, smooth: Arr, i: int, half: int, top: bool, first: bool) -> float:
@@ -227,15 +241,15 @@ def step_response(rec: JointRecord, thesis: bool = False) -> SlideFit:
         A = np.column_stack([-e[:-1], np.sign(e[:-1])])
         (r, g), *_ = np.linalg.lstsq(A, e[1:], rcond=None)
         coulomb: float | None = k * float(g) / (1.0 + float(r))
-    elif spring is not None and rested:
+    elif spring is not None:
         raise IdentificationError(
-            f"{rec.joint}: the step response swung once and stopped on friction; the step "
-            "method needs two swings to tell damping from friction (a larger step), or use "
-            "least squares"
+            f"{rec.joint}: the step response swung only once (it stopped on friction, or the "
+            "record or the next step cut it); the step method needs two swings to tell damping "
+            "from friction (a larger or longer step), or use least squares"
         )
     else:  # the thesis's: the first overshoot, no Coulomb friction
         r, coulomb = float(-e[1] / e[0]), None
-    if not r > 0.0:
+    if not r > OVERSHOOT_MIN:
         raise IdentificationError(_over_damped(rec.joint))
     if not r < 1.0:
         raise IdentificationError(
@@ -259,7 +273,8 @@ def step_response(rec: JointRecord, thesis: bool = False) -> SlideFit:
     c = 2.0 * zeta * math.sqrt(k * m)
     if spring is not None:
         c += 0.5 * k * dt  # the spring, held over each period, lags dt/2: -k dt/2 of damping
-    return SlideFit("step", rec.joint, m, c, coulomb, None, None, None, len(x), None)
+    method = "thesis_step" if thesis else "step"
+    return SlideFit(method, rec.joint, m, c, coulomb, None, None, None, len(x), None)
 
 
 def identify(rec: JointRecord, method: str = "least_squares") -> SlideFit:
@@ -267,5 +282,5 @@ def identify(rec: JointRecord, method: str = "least_squares") -> SlideFit:
     if method == "least_squares":
         return least_squares(rec)
     if method in ("step", "thesis_step"):
-        return replace(step_response(rec, thesis=method == "thesis_step"), method=method)
+        return step_response(rec, thesis=method == "thesis_step")
     raise IdentificationError(f"method must be one of {', '.join(METHODS)}, got {method!r}")

@@ -35,17 +35,21 @@ class ArmSpec:
     joints: tuple[str, ...] = ()
 
 
-#: the step method's Coulomb friction where the step response could not separate it
-NO_COULOMB = "- (not separated from the damping: needs a rendered spring and two swings)"
+#: the Coulomb friction of a method that does not identify it
+NO_COULOMB = {
+    "step": "- (not separated from the damping: the effort holds no spring)",
+    "thesis_step": "- (the thesis's formulas leave it out)",
+}
 
 
 def table(fit: SlideFit, bag: str) -> str:
     """The fit as a short table (units in the row names)."""
+    no_fc = NO_COULOMB.get(fit.method, "-")
     rows = [
         f"bag {bag}, joint {fit.joint}, method {fit.method}, {fit.samples} samples",
         f"mass_kg              {plus_minus(fit.mass_kg, fit.mass_std, '.4f')}",
         f"viscous_n_s_per_m    {plus_minus(fit.viscous_n_s_per_m, fit.viscous_std, '.4f')}",
-        f"coulomb_n            {plus_minus(fit.coulomb_n, fit.coulomb_std, '.4f', NO_COULOMB)}",
+        f"coulomb_n            {plus_minus(fit.coulomb_n, fit.coulomb_std, '.4f', no_fc)}",
     ]
     if fit.rms_residual_n is not None:
         rows.append(f"rms residual (N)     {fit.rms_residual_n:.4f}")

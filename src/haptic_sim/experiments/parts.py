@@ -243,9 +243,9 @@ SWEEPS: Experiment[sweeps.SweepStudy] = Experiment(
         lambda r: f"Table 7.1's off cells swept: {len(r.cells)} sessions",
     ),
     heading="Table 7.1's cells that stay off, against the parameter responsible (batch)",
-    intro="Each controller of Table 7.1 in the chapter-7 session (40 s, the same seed and "
-    "hand) at one wall, with one parameter swept from the chapter-7 value: the hand's grip "
-    "damping at 2400 N/m, the actuator's force limit at 80 N/m.",
+    intro="Each controller of Table 7.1 in the chapter-7 session (40 s, the hand's seed 0, "
+    "as chapter 7's default) at one wall, with one parameter swept from the chapter-7 value: "
+    "the hand's grip damping at 2400 N/m, the actuator's force limit at 80 N/m.",
     body=lambda r, _base: [
         sweeps.sweep_table(r, sweeps.GRIP),
         sweeps.grip_text(r),

@@ -5,8 +5,11 @@ every 3 s by default. Between processes on one machine, samples go through share
 of 512 messages; on a loaded machine a reader's port overflows now and then (two recorders beside
 the loop on 2 cores), and each loss then stalls that reader, and a lockstep run that waits for
 it, for up to 3 s. ``fastdds_profile.xml`` sets the heartbeat to 50 ms: lockstep with two
-recorders went from 0.3-0.4 to 2.6-3.1 times real time (BENCHMARKS.md). It changes nothing else
-(transports, discovery and the QoS the nodes set are Fast DDS's and ROS's defaults).
+recorders went from 0.34 to 3.42 times real time (medians, BENCHMARKS.md). It changes nothing
+else (transports, discovery and the QoS the nodes set are Fast DDS's and ROS's defaults).
+A profile the user names (``FASTRTPS_DEFAULT_PROFILES_FILE``, or ``FASTDDS_DEFAULT_PROFILES_FILE``
+of newer Fast DDS) replaces it. Fast DDS also looks for ``DEFAULT_FASTRTPS_PROFILES.xml`` in the
+working directory, whose default writer profile may apply instead (not checked here).
 """
 
 from __future__ import annotations
@@ -15,10 +18,13 @@ import os
 from pathlib import Path
 
 PROFILES_ENV = "FASTRTPS_DEFAULT_PROFILES_FILE"
+NEWER_PROFILES_ENV = "FASTDDS_DEFAULT_PROFILES_FILE"  # Fast DDS 3 (ROS 2 Kilted on)
 PROFILE = Path(__file__).with_name("fastdds_profile.xml")
 
 
 def use_default_profile() -> str:
-    """Point Fast DDS at ``PROFILE`` unless ``FASTRTPS_DEFAULT_PROFILES_FILE`` is set (a user's
-    own profile wins); call before ``rclpy.init``. Returns the profile file in effect."""
+    """Point Fast DDS at ``PROFILE`` unless the user names a profile file (theirs wins); call
+    before ``rclpy.init``. Returns the profile file in effect."""
+    if NEWER_PROFILES_ENV in os.environ and PROFILES_ENV not in os.environ:
+        return os.environ[NEWER_PROFILES_ENV]
     return os.environ.setdefault(PROFILES_ENV, str(PROFILE))
