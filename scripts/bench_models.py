@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from haptic_dob.models.base import DeviceModel
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from benchmarks import machine
 
@@ -32,10 +34,10 @@ def _median_us(fn: Callable[[], object], repeat: int, number: int) -> tuple[floa
     return statistics.median(runs), min(runs)
 
 
-def _observer(model: object, q: tuple, qd: tuple, tau: tuple, repeat: int) -> str:
+def _observer(model: DeviceModel, q: tuple, qd: tuple, tau: tuple, repeat: int) -> str:
     from haptic_dob.observer import DisturbanceObserver
 
-    obs = DisturbanceObserver(model, 2.0, 1e-3, 50.0)  # type: ignore[arg-type]
+    obs = DisturbanceObserver(model, 2.0, 1e-3, 50.0)
     obs.update(q, qd, tau)
     n = 20_000
     upd, upd_min = _median_us(lambda: obs.update(q, qd, tau), repeat, n)

@@ -365,3 +365,9 @@ def switch(env: dict[str, str], mode: str, within: float = 30.0) -> tuple[bool, 
 
     wait_until(answered, within, poll_s=0.5)
     return answer
+
+
+def read_force(msg: Any) -> tuple[float, float, float]:
+    """Force (N) of a WrenchStamped (rclpy or rosbags message)."""
+    f = msg.wrench.force
+    return (f.x, f.y, f.z)

@@ -43,11 +43,6 @@ def test_a_huge_normal_is_a_direction_too() -> None:
         assert VirtualWall(normal=normal).normal == pytest.approx(unit)
 
 
-def test_desired_impedance() -> None:
-    z = VirtualWall(800.0, 2.0).desired_impedance([0.0, 1.0])
-    np.testing.assert_allclose(z, [800.0, 800.0 + 2j * 2.0 * np.pi])
-
-
 @pytest.mark.parametrize(
     ("kwargs", "name"),
     [

@@ -8,10 +8,9 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from haptic_msgs_py.convert import read_force
 from haptic_msgs_py.stamps import stamp_ns
 from haptic_msgs_py.topics import HAND_WRENCH, SESSION_TOPICS, WRENCH_ESTIMATE
-from rosgraph import Collector, isolated_env, launch
+from rosgraph import Collector, isolated_env, launch, read_force
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 

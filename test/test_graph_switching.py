@@ -8,7 +8,6 @@ import time
 import numpy as np
 import pytest
 
-from haptic_msgs_py.convert import read_force
 from haptic_msgs_py.stamps import command_stamp, stamp_ns
 from haptic_msgs_py.topics import (
     EFFORT_COMMAND,
@@ -18,7 +17,7 @@ from haptic_msgs_py.topics import (
     WRENCH_ESTIMATE,
     WRENCH_MEASURED,
 )
-from rosgraph import Collector, isolated_env, launch, set_parameter, switch
+from rosgraph import Collector, isolated_env, launch, read_force, set_parameter, switch
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 

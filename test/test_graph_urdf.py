@@ -19,9 +19,8 @@ import numpy as np
 import pytest
 
 from haptic_dob.observer import DisturbanceObserver
-from haptic_msgs_py.convert import read_force
 from haptic_msgs_py.stamps import stamp_ns
-from rosgraph import BIN, Collector, Process, isolated_env
+from rosgraph import BIN, Collector, Process, isolated_env, read_force
 from test_urdf import ARM3, GAIN, check_known_force, known_force_run
 from waits import wait_until
 

@@ -213,7 +213,7 @@ def test_observer_rejects_bad_settings(kwargs: dict, name: str) -> None:
 
 def test_observer_rejects_a_model_that_is_not_one() -> None:
     with pytest.raises(ValueError, match="model"):
-        DisturbanceObserver("slide", 10.0, 1e-3)  # type: ignore[arg-type]
+        DisturbanceObserver("slide", 10.0, 1e-3)  # type: ignore[arg-type]  # the wrong type on purpose
 
 
 @pytest.mark.parametrize(

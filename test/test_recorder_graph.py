@@ -116,7 +116,7 @@ def test_recorded_lockstep_session_loses_nothing_and_equals_the_batch_run(root, 
 
 def switch_stamp(path: Path, kf: float) -> int:
     """Stamp (ns) of the first command computed by the DOB law (from the recorded signals)."""
-    from haptic_msgs_py.convert import read_force
+    from rosgraph import read_force
 
     by: dict[str, dict[int, float]] = {"/wrench_desired": {}, "/wrench_estimate": {}}
     cmds: list[tuple[int, float]] = []
@@ -129,7 +129,9 @@ def switch_stamp(path: Path, kf: float) -> int:
                 )[0]
             elif conn.topic == "/effort_command":
                 m = reader.deserialize(data, conn.msgtype)
-                cmds.append((command_label_stamp_ns(data), float(m.data[0])))  # type: ignore[arg-type]
+                stamp = command_label_stamp_ns(data)
+                assert stamp is not None, "a command without its cycle label"
+                cmds.append((stamp, float(m.data[0])))
     first = None
     for k, u in sorted(cmds):
         if k not in by["/wrench_estimate"]:

@@ -108,8 +108,3 @@ class VirtualWall:
         """``force`` with shape and finiteness checks (``ValueError`` names the argument)."""
         p3, v3 = vector("p", p, 3), vector("v", v, 3)
         return self.force(tuple(p3.tolist()), tuple(v3.tolist()))
-
-    def desired_impedance(self, freqs_hz: ArrayLike) -> np.ndarray:
-        """Desired impedance Z_d(j w) = K + j B w (N/m) at ``freqs_hz``."""
-        w = 2.0 * np.pi * np.asarray(freqs_hz, dtype=np.float64)
-        return self.stiffness_n_per_m + 1j * self.damping_n_s_per_m * w

@@ -221,8 +221,8 @@ class DisturbanceObserver:
         try:
             if (
                 len(q) == n  # type: ignore[arg-type]  # checked Sequence on the fast path
-                and len(qd) == n  # type: ignore[arg-type]  # same
-                and len(tau) == n  # type: ignore[arg-type]  # same
+                and len(qd) == n  # type: ignore[arg-type]  # checked Sequence on the fast path
+                and len(tau) == n  # type: ignore[arg-type]  # checked Sequence on the fast path
                 and not isinstance(q, (str, bytes))
                 and not isinstance(qd, (str, bytes))
                 and not isinstance(tau, (str, bytes))

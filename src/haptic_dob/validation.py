@@ -76,7 +76,7 @@ def scalar_of(name: str, value: object) -> float:
     elif kind is tuple or kind is list or kind is np.ndarray or kind is array.array:
         if len(value) != 1:  # type: ignore[arg-type]  # a sized kind, checked above
             raise ValueError(f"{name} must be a scalar or a length-1 vector, got {value!r}")
-        x = float(value[0])  # type: ignore[index]  # same
+        x = float(value[0])  # type: ignore[index]  # a sized kind, checked above
     elif isinstance(value, (int, np.floating, np.integer)) and not isinstance(value, bool):
         x = float(value)
     elif isinstance(value, Sequence) and not isinstance(value, str) and len(value) == 1:

@@ -93,16 +93,6 @@ class Bus:
         t.listeners.append(listener)
         return t
 
-    def remove_subscriber(
-        self, name: str, callback: Callback, listener: Callable[[], None]
-    ) -> None:
-        """Stop delivering to ``callback``."""
-        t = self.topic(name)
-        if callback in t.subscribers:
-            t.subscribers.remove(callback)
-        if listener in t.listeners:
-            t.listeners.remove(listener)
-
     # --- the hand-over --------------------------------------------------------------------
     def deliver(self, subscribers: list[Callback], value: Any) -> None:
         """Call each subscriber with ``value`` (depth first), then, when this was the outermost

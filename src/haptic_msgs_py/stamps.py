@@ -15,11 +15,6 @@ NS_PER_S = 1_000_000_000
 COMMAND_LABEL = "effort@"
 
 
-def to_ns(sec: int, nanosec: int) -> int:
-    """Integer nanoseconds of a ``builtin_interfaces/Time``."""
-    return sec * NS_PER_S + nanosec
-
-
 def stamp_ns(msg: Any) -> int:
     """Nanoseconds of ``msg.header.stamp`` (works for rclpy and rosbags messages)."""
     st = msg.header.stamp

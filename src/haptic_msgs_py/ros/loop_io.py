@@ -135,11 +135,6 @@ class LoopSubscription:
     def _on_bytes(self, data: bytes) -> None:
         self._callback(self._decode(data))
 
-    @property
-    def in_process(self) -> bool:
-        """Whether the topic comes from a publisher in this process."""
-        return bool(self._topic.publishers)
-
     def get_publisher_count(self) -> int:
         """Publishers here and, while listening on DDS, the matched ones elsewhere."""
         return len(self._topic.publishers) + (self.dds.get_publisher_count() if self.dds else 0)
