@@ -43,6 +43,7 @@ import numpy as np
 
 from haptic_dob.models.base import DeviceModel, Vec
 from haptic_dob.validation import positive, unit_vector, vector
+from haptic_msgs_py.stamps import period_ns
 from haptic_sim.arm_dynamics import coulomb_smoothing, dynamics_and_tip, mass_and_bias, solve
 from haptic_sim.arm_params import ArmDeviceParams
 from haptic_sim.device import DeviceSample
@@ -94,7 +95,7 @@ class SimulatedArm:
         if int(substeps) != substeps or substeps < 1:
             raise ValueError(f"substeps must be an integer >= 1, got {substeps!r}")
         self.substeps = int(substeps)
-        self.period_ns = round(1e9 / self.rate_hz)
+        self.period_ns = period_ns(self.rate_hz)
         self.dt = self.period_ns * 1e-9
         self.dt_physics = self.dt / self.substeps
         n = self.dof

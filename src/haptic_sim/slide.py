@@ -41,6 +41,7 @@ from haptic_dob.models.slide import (
 )
 from haptic_dob.runtime.params import param
 from haptic_dob.validation import finite_scalar, nonnegative, positive, unit_vector
+from haptic_msgs_py.stamps import period_ns
 from haptic_sim.device import DeviceSample
 from haptic_sim.hand import HandParams, HandReference
 from haptic_sim.sensor import ForceSensor, ForceSensorParams, quantize
@@ -156,7 +157,7 @@ class SimulatedSlide:
         if int(substeps) != substeps or substeps < 1:
             raise ValueError(f"substeps must be an integer >= 1, got {substeps!r}")
         self.substeps = int(substeps)
-        self.period_ns = round(1e9 / self.rate_hz)
+        self.period_ns = period_ns(self.rate_hz)
         self.dt = self.period_ns * 1e-9
         self.dt_physics = self.dt / self.substeps
         d = self.device

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from haptic_msgs_py import wire
-from haptic_msgs_py.stamps import NS_PER_S
+from haptic_msgs_py.stamps import NS_PER_S, period_ns
 from haptic_msgs_py.topics import (
     EE_POSE,
     EE_TWIST,
@@ -279,7 +279,7 @@ def write_session_bag(
     xs = np.asarray(x, np.float64).tolist()
     fs_ = np.asarray(force, np.float64).tolist()
     vs = None if velocity is None else np.asarray(velocity, np.float64).tolist()
-    period = round(NS_PER_S / rate_hz)
+    period = period_ns(rate_hz)
     ns = namespace.rstrip("/")
     writer = open_writer(path, storage)
     count = 0

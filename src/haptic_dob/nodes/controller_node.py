@@ -42,6 +42,7 @@ from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
+from haptic_msgs_py.stamps import period_ns
 from haptic_msgs_py.topics import (
     EFFORT_COMMAND,
     JOINT_STATES,
@@ -101,7 +102,7 @@ class ControllerNode(LoopNode):
         self.params = ParameterTable(self, controller_node_specs(), self._settings, self._apply)
         values = self.params.values
         self.model = build_model(values)
-        self.period_ns = round(1e9 / values["rate_hz"])
+        self.period_ns = period_ns(values["rate_hz"])
         log = self.get_logger()
         self.join = CommandJoin(
             ImpedanceController(self.model, self.params.settings),

@@ -24,6 +24,7 @@ from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
+from haptic_msgs_py.stamps import period_ns
 from haptic_msgs_py.topics import EE_POSE, EE_TWIST, WRENCH_DESIRED
 from haptic_msgs_py.values import StampedVector
 
@@ -56,7 +57,7 @@ class EnvironmentNode(LoopNode):
         self._adds = self.excitation if self.excitation.active else None  # what wall_force adds
         self._pose: StampedVector | None = None
         self._twist: StampedVector | None = None
-        self._period_ns = round(1e9 / self.params.values["rate_hz"])
+        self._period_ns = period_ns(self.params.values["rate_hz"])
         self._emitted_ns = -1  # stamp of the newest wall force
         self._pub = LoopPublisher(
             self, WRENCH_DESIRED, codecs.WRENCH, qos.LOOP, self.params.values["base_frame"]

@@ -30,6 +30,7 @@ from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
+from haptic_msgs_py.stamps import period_ns
 from haptic_msgs_py.topics import EFFORT_ESTIMATE, JOINT_STATES, WRENCH_ESTIMATE
 from haptic_msgs_py.values import JointSample, StampedVector
 
@@ -86,7 +87,7 @@ class ObserverNode(LoopNode):
         self.params = ParameterTable(self, observer_node_specs(), self._settings, self._apply)
         values = self.params.values
         self.model: DeviceModel = build_model(values)
-        self.period_ns = round(1e9 / values["rate_hz"])
+        self.period_ns = period_ns(values["rate_hz"])
         self.observer = self._make_observer(self.params.settings)
         self.joints = JointMap(self.model.joint_names)
         self._last_ns = -1
