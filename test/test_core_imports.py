@@ -5,6 +5,7 @@ from __future__ import annotations
 import ast
 import pathlib
 import pkgutil
+import re
 import subprocess
 import sys
 
@@ -72,6 +73,40 @@ def test_layers_have_no_arrow_back() -> None:
             for name in sorted(imported_packages(path) & above):
                 back.append(f"{path.relative_to(src)} imports {name}")
     assert back == []
+
+
+def named_modules(path: pathlib.Path) -> set[str]:
+    """Top-level packages of the suite that ``path`` names in a module path string
+    (``"pkg.module"`` or ``"pkg.module:Class"``, the form importlib and entry points take)."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str):
+            m = re.fullmatch(r"(\w+)(\.\w+)+(:\w+)?", node.value)
+            if m:
+                found.add(m.group(1))
+    return found & set(LAYERS)
+
+
+def test_no_arrow_back_through_a_module_path_either() -> None:
+    """A lower layer does not import an upper one by name at run time either (importlib): the
+    simulator's device node is registered as an entry point, not named by the control side."""
+    src = pathlib.Path(haptic_dob.__file__).resolve().parents[1]
+    back = []
+    for i, pkg in enumerate(LAYERS):
+        above = set(LAYERS[:i])
+        for path in sorted((src / pkg).rglob("*.py")):
+            for name in sorted(named_modules(path) & above):
+                back.append(f"{path.relative_to(src)} names a module of {name}")
+    assert back == []
+
+
+def test_the_registry_finds_every_node_through_its_entry_point() -> None:
+    from haptic_dob.nodes.registry import NODES, START_ORDER, node_class
+
+    assert list(NODES) == list(START_ORDER)
+    assert NODES["device_node"].package == "haptic_sim"
+    assert node_class("device_node").__name__ == "DeviceNode"
+    assert {NODES[n].package for n in START_ORDER if n != "device_node"} == {"haptic_dob"}
 
 
 def test_messages_package_holds_no_runtime() -> None:

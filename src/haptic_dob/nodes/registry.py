@@ -1,13 +1,15 @@
 """The suite's nodes: name -> ROS package, executable and class; which of them form the loop.
 
 Tools that start nodes (``haptic-launch``, the container, the launch file) look them up here by
-name; the classes are imported only when a process hosts them (``node_class``), so the control
-side never imports the simulator unless a simulated device runs in the process.
+name. Packages register their nodes as entry points (``ENTRY_POINT_GROUP``, in the project's
+metadata); the classes are imported only when a process hosts them (``node_class``), so the
+control side neither names nor imports the simulator unless a simulated device runs there.
 """
 
 from __future__ import annotations
 
 import importlib
+from importlib.metadata import entry_points
 from typing import NamedTuple
 
 
@@ -19,24 +21,6 @@ class NodeEntry(NamedTuple):
     cls: str
 
 
-NODES: dict[str, NodeEntry] = {
-    "environment_node": NodeEntry(
-        "haptic_dob", "environment_node", "haptic_dob.nodes.environment_node:EnvironmentNode"
-    ),
-    "observer_node": NodeEntry(
-        "haptic_dob", "observer_node", "haptic_dob.nodes.observer_node:ObserverNode"
-    ),
-    "controller_node": NodeEntry(
-        "haptic_dob", "controller_node", "haptic_dob.nodes.controller_node:ControllerNode"
-    ),
-    "recorder_node": NodeEntry(
-        "haptic_dob", "recorder_node", "haptic_dob.nodes.recorder_node:RecorderNode"
-    ),
-    "device_node": NodeEntry(
-        "haptic_sim", "device_node", "haptic_sim.nodes.device_node:DeviceNode"
-    ),
-}
-
 #: the order nodes start in: a recorder first, the device (which waits for the rest) last
 START_ORDER = (
     "recorder_node",
@@ -45,6 +29,24 @@ START_ORDER = (
     "controller_node",
     "device_node",
 )
+
+#: the entry-point group where each package registers its nodes (``name = "module:Class"``):
+#: the simulator registers its device node there, so the control side never names it
+ENTRY_POINT_GROUP = "haptic_dob.nodes"
+
+
+def _registered() -> dict[str, NodeEntry]:
+    """Every node a package registered: the ROS package is the class's top-level package and
+    the executable is the node's name (``ros/lib/<package>/<name>``)."""
+    found = {
+        ep.name: NodeEntry(ep.value.split(".", 1)[0], ep.name, ep.value)
+        for ep in entry_points(group=ENTRY_POINT_GROUP)
+    }
+    order = {n: i for i, n in enumerate(START_ORDER)}
+    return dict(sorted(found.items(), key=lambda item: (order.get(item[0], len(order)), item[0])))
+
+
+NODES: dict[str, NodeEntry] = _registered()
 
 #: the nodes that close the loop: composed in one process by default (``haptic-launch``)
 LOOP_NODES = ("device_node", "environment_node", "observer_node", "controller_node")
