@@ -8,17 +8,16 @@ re-published sample in lockstep is safe); an older one is ignored. ``~/reset`` r
 
 from __future__ import annotations
 
-import math
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from typing import Any
 
-import numpy as np
 from rclpy.context import Context
 from std_srvs.srv import Trigger
 
 from haptic_dob.control import ZERO_FORCE, Force
 from haptic_dob.cycle import estimate
+from haptic_dob.joint_states import JointMap, joint_vectors
 from haptic_dob.models.base import DeviceModel
 from haptic_dob.models.factory import build_model, model_specs
 from haptic_dob.nodes.common import loop_specs, main_for, process_specs
@@ -33,45 +32,6 @@ from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
 from haptic_msgs_py.stamps import period_ns
 from haptic_msgs_py.topics import EFFORT_ESTIMATE, JOINT_STATES, WRENCH_ESTIMATE
 from haptic_msgs_py.values import JointSample, StampedVector
-
-
-class JointMap:
-    """Pick a model's joints out of a JointState by name (any order, extra joints ignored)."""
-
-    def __init__(self, joint_names: Sequence[str]) -> None:
-        self.joint_names = tuple(joint_names)
-        self._names: tuple[str, ...] | None = None
-        self._index: list[int] = []
-
-    def index(self, names: Sequence[str], n_values: int) -> list[int]:
-        """Positions of the model's joints in a message with ``names`` (ValueError if missing)."""
-        if not names:
-            if n_values != len(self.joint_names):
-                raise ValueError(
-                    f"joint_states without names must have {len(self.joint_names)} values in "
-                    f"model order, got {n_values}"
-                )
-            return list(range(n_values))
-        if names == self._names:  # the same names as the last message (tuples)
-            return self._index
-        where = {n: i for i, n in enumerate(names)}
-        missing = [j for j in self.joint_names if j not in where]
-        if missing:
-            raise ValueError(
-                f"joint_states lacks joint(s) {', '.join(missing)} of the model "
-                f"(it has: {', '.join(names)})"
-            )
-        self._names = tuple(names)
-        self._index = [where[j] for j in self.joint_names]
-        return self._index
-
-
-def pick(values: Any, index: list[int], what: str, n_names: int) -> list[float]:
-    """The model's joints (floats) out of one JointState field (ValueError on a length mismatch)."""
-    if len(values) != n_names:
-        raise ValueError(f"joint_states {what} has {len(values)} values for {n_names} joints")
-    seq = values.tolist() if isinstance(values, np.ndarray) else values
-    return [float(seq[i]) for i in index]
 
 
 def observer_node_specs() -> list[ParamSpec]:
@@ -164,19 +124,10 @@ class ObserverNode(LoopNode):
             self._publish(now)
             return
         try:
-            idx = self.joints.index(js.name, len(js.position))
-            n = len(js.name) or len(js.position)
-            q = pick(js.position, idx, "position", n)
-            if len(js.velocity):
-                qd = pick(js.velocity, idx, "velocity", n)
-            elif self._prev_q is not None and now > self._last_ns:
-                dt = (now - self._last_ns) * 1e-9
-                qd = [(a - b) / dt for a, b in zip(q, self._prev_q, strict=True)]
-            else:
-                qd = [0.0] * len(q)
-            tau = pick(js.effort, idx, "effort", n) if len(js.effort) else [0.0] * len(q)
-            if not all(map(math.isfinite, q + qd + tau)):
-                raise ValueError("joint_states holds NaN or inf")
+            dt = (now - self._last_ns) * 1e-9 if self._prev_q is not None else 0.0
+            q, qd, tau = joint_vectors(
+                self.joints, js.name, js.position, js.velocity, js.effort, self._prev_q, dt
+            )
         except ValueError as exc:
             self._complain(str(exc))
             return
