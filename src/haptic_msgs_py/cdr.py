@@ -2,7 +2,7 @@
 
 The 1 kHz path needs a stamp and three numbers from a ``WrenchStamped``, or a handful of joint
 values: building and reading whole message objects (``rosbags``' generic codec, ``wire``) costs
-about 10 us a message on a slow machine, ``struct`` well under one. These functions cover what the
+an order of magnitude more than ``struct`` does. These functions cover what the
 loop publishes and takes; each reader returns None for anything it does not know for sure
 (big-endian data, a truncated message), and the caller then falls back on the generic codec.
 Tests check byte equality with ``rosbags``' serializer.

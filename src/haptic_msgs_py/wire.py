@@ -1,9 +1,9 @@
 """Messages on the wire: the ``rosbags`` CDR codec and message classes, for nodes and bags alike.
 
 The loop's nodes publish and subscribe raw (serialized) messages and use the ``rosbags``
-type store (ROS 2 Jazzy definitions) to encode and decode them: its generated codec turns a
-WrenchStamped into bytes in about 2 us and back in about 3.5 us, where rclpy's Python message
-conversion takes about 14 us per received message. The bytes are the same CDR rclpy produces,
+type store (ROS 2 Jazzy definitions) to encode and decode them: its generated codec is several
+times faster than rclpy's Python message conversion of each received message (BENCHMARKS.md has
+the figures). The bytes are the same CDR rclpy produces,
 so any ROS 2 node (``ros2 topic echo``, a C++ driver) talks to these nodes as usual, and the
 same message classes come out of recorded bags.
 """
