@@ -1,12 +1,5 @@
-"""A teleoperation session's configuration: one ``ros__parameters`` YAML for both sides.
-
-Sections are keyed by namespace: ``/master/<node>`` and ``/slave/<node>``, with ``/**``,
-``/master/**``, ``/slave/**`` and ``/**/<node>`` for what several nodes share. A node's
-parameters are those sections overlaid from the general to the specific: ``/**``, ``/<ns>/**``,
-``/**/<node>``, ``/<ns>/<node>``. The nodes: on both sides ``device_node``, ``observer_node`` and
-the channel's end ``channel_node``; the master's ``controller_node`` (the haptic law rendering the
-channel's force) and the slave's ``slave_controller_node`` (the joint impedance). The node graph
-and the batch runner read the same file.
+"""A teleoperation session's configuration: one ``ros__parameters`` YAML for both sides, read
+as the node graph reads it (sections by namespace: ``haptic_dob.teleop.graph``).
 """
 
 from __future__ import annotations
@@ -21,41 +14,14 @@ from haptic_dob.environment import VirtualWall
 from haptic_dob.models.base import DeviceModel
 from haptic_dob.models.factory import build_model
 from haptic_dob.observer import ObserverSettings
-from haptic_dob.runtime.params import build, load_sections
+from haptic_dob.runtime.params import build
+from haptic_dob.teleop.graph import NAMESPACES, check_sections, load_teleop_sections, node_values
 from haptic_dob.teleop.settings import ChannelSettings, TeleopSettings
 from haptic_dob.teleop.slave import SlaveImpedance
 from haptic_sim.arm import SimulatedArm
 from haptic_sim.factory import NO_CONTACT, build_device
 from haptic_sim.session import LoopSettings
 from haptic_sim.slide import SimulatedSlide
-
-NAMESPACES = ("master", "slave")
-#: the nodes of each side
-NODES = {
-    "master": ("device_node", "observer_node", "controller_node", "channel_node"),
-    "slave": ("device_node", "observer_node", "slave_controller_node", "channel_node"),
-}
-
-
-def node_values(sections: Mapping[str, Mapping[str, Any]], ns: str, node: str) -> dict[str, Any]:
-    """The parameters node ``/<ns>/<node>`` gets from ``sections`` (general to specific)."""
-    out: dict[str, Any] = {}
-    for key in ("/**", f"/{ns}/**", f"/**/{node}", f"/{ns}/{node}"):
-        out.update(sections.get(key, {}))
-    return out
-
-
-def check_sections(sections: Mapping[str, Any]) -> None:
-    """``ValueError`` for a section that names no node of a teleoperation graph."""
-    known = {"/**", *(f"/{ns}/**" for ns in NAMESPACES)}
-    known |= {f"/**/{n}" for nodes in NODES.values() for n in nodes}
-    known |= {f"/{ns}/{n}" for ns, nodes in NODES.items() for n in nodes}
-    unknown = sorted(set(sections) - known)
-    if unknown:
-        raise ValueError(
-            f"section(s) {', '.join(unknown)} name no node of the teleoperation graph "
-            f"(/master/{{{','.join(NODES['master'])}}}, /slave/{{{','.join(NODES['slave'])}}})"
-        )
 
 
 @dataclass(frozen=True)
@@ -125,7 +91,7 @@ class TeleopConfig:
     @classmethod
     def from_yaml(cls, path: str | Path) -> TeleopConfig:
         """Load a teleoperation ``ros__parameters`` YAML file."""
-        return cls.from_sections(load_sections(path))
+        return cls.from_sections(load_teleop_sections(path))
 
     def override(self, changes: Mapping[str, Mapping[str, Any]]) -> TeleopConfig:
         """A copy with parameters set, by section (``{"/**/channel_node": {"channel.passivity":

@@ -58,7 +58,8 @@ def run_teleop(config: TeleopConfig, cycles: int | None = None) -> TeleopResult:
     )
     s_obs = config.slave_observer.build(config.model("slave", "observer_node"), dt)
     s_ctl = SlaveController(config.model("slave", "slave_controller_node"), config.slave, dt)
-    axis = tuple(float(a) for a in m_model.axis) if isinstance(m_model, SlideModel) else None
+    end_model = config.model("master", "channel_node")  # the master's axis, for a slide
+    axis = tuple(float(a) for a in end_model.axis) if isinstance(end_model, SlideModel) else None
     m_end = MasterEnd(config.teleop, config.channel, period, axis)  # type: ignore[arg-type]  # 3 floats
     s_end = SlaveEnd(config.teleop, config.channel, period)
     sensor = config.teleop.force_source == "sensor"

@@ -29,6 +29,14 @@ NODES: dict[str, NodeEntry] = {
     "controller_node": NodeEntry(
         "haptic_dob", "controller_node", "haptic_dob.nodes.controller_node:ControllerNode"
     ),
+    "channel_node": NodeEntry(
+        "haptic_dob", "channel_node", "haptic_dob.nodes.channel_node:ChannelNode"
+    ),
+    "slave_controller_node": NodeEntry(
+        "haptic_dob",
+        "slave_controller_node",
+        "haptic_dob.nodes.slave_controller_node:SlaveControllerNode",
+    ),
     "recorder_node": NodeEntry(
         "haptic_dob", "recorder_node", "haptic_dob.nodes.recorder_node:RecorderNode"
     ),
@@ -43,6 +51,8 @@ START_ORDER = (
     "environment_node",
     "observer_node",
     "controller_node",
+    "channel_node",
+    "slave_controller_node",
     "device_node",
 )
 
