@@ -50,6 +50,15 @@ def test_a_run_is_deterministic(config) -> None:
             assert np.array_equal(getattr(a, f.name), getattr(b, f.name)), f.name
 
 
+def test_the_phantom_as_master_renders_the_slave_force_in_3d(root) -> None:
+    """config/teleop_phantom_sim.yaml: the PHANToM's handle moves the slave's tool one to one in
+    direction; 1.5 s: the slave reaches the table and the PHANToM renders its force."""
+    cfg = TeleopConfig.from_yaml(root / "config" / "teleop_phantom_sim.yaml")
+    m = run_teleop(cfg, 1500).metrics()
+    assert m.contact_pct > 20.0 and m.contact_force_rms_n > 5.0
+    assert m.estimate_error_pct < 10.0 and m.force_tracking_error_pct < 10.0, m
+
+
 # --- with nothing in contact -------------------------------------------------------------------
 FRICTION = ("urdf.viscous_n_m_s_per_rad", "urdf.coulomb_n_m")
 

@@ -14,13 +14,12 @@ from haptic_sim.teleop_stability import DelayPoint
 
 
 def plot_force_tracking(result: TeleopResult, path: Path) -> None:
-    """Along the master's axis in the slave's frame: the true contact force, the observer's
-    estimate, the force the master renders (scaled back) and the wrist sensor; the points of
+    """Along the table's normal (into it): the true contact force, the observer's estimate, the
+    force the master renders (scaled back to the slave) and the wrist sensor; the points of
     master (mapped), target and slave; the channel's net energy."""
     plt = pyplot()
     cfg = result.config
-    R = cfg.teleop.matrix
-    u = R[:, 0]  # the master's x axis in the slave's frame (the slide's axis)
+    u = np.asarray(cfg.contact.normal)  # from free space into the table
     t = result.t
     fig, (ax_f, ax_x, ax_e) = plt.subplots(3, 1, figsize=(8.0, 8.0), sharex=True)
     ax_f.plot(t, -result.contact @ u, "k", lw=1.4, label="true contact")
@@ -41,11 +40,9 @@ def plot_force_tracking(result: TeleopResult, path: Path) -> None:
         ("slave", result.slave_point, "k"),
     ):
         ax_x.plot(t, ((x - p0) @ u) * 1e3, style, lw=1.0, label=name)
-    n = np.asarray(cfg.contact.normal)
-    if abs(float(n @ u)) > 0.5:
-        surface = float((np.asarray(cfg.contact.position) - p0) @ n) / float(n @ u)
-        ax_x.axhline(surface * 1e3, color="0.5", lw=0.8, ls=":", label="table")
-    ax_x.set_ylabel("along the push (mm)")
+    surface = float((np.asarray(cfg.contact.position) - p0) @ u)
+    ax_x.axhline(surface * 1e3, color="0.5", lw=0.8, ls=":", label="table")
+    ax_x.set_ylabel("toward the table (mm)")
     ax_x.legend(loc="upper right", fontsize=8)
     ax_e.plot(t, result.channel_energy, "k", lw=1.0)
     ax_e.axhline(0.0, color="0.5", lw=0.8)

@@ -13,8 +13,8 @@ Outside contact: ``free_estimate_max_n``, the largest estimate while nothing tou
 master's point mapped to the slave. Channel: ``channel_energy_min_j``, the lowest net energy
 the channel took in (``E_in`` minus ``E_out`` of both ports; below zero it has generated energy),
 ``dissipated_j`` what the passivity controllers took out, and ``oscillation_mm``, the standard
-deviation of the master's position over the last second band-passed above 2 Hz (a loop that
-vibrates; the hand's own motion lies below).
+deviation of the master's point over the last second high-passed at 2 Hz, on its most moving
+axis (a loop that vibrates; the hand's own motion lies below).
 """
 
 from __future__ import annotations
@@ -133,7 +133,9 @@ class TeleopResult:
             channel_energy_min_j=float(np.min(e)),
             channel_energy_final_j=float(e[-1]),
             dissipated_j=float(self.dissipated[-1]),
-            oscillation_mm=oscillation(self.master_q, fs) * 1e3,
+            oscillation_mm=max(oscillation(x, fs) for x in self.master_point.T)
+            * 1e3
+            / cfg.teleop.position_scale,
         )
 
     def save(self, path: str | Path) -> None:
