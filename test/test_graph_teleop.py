@@ -15,7 +15,7 @@ from rosgraph import Collector, isolated_env, launch, resent
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
-CYCLES = 1500
+CYCLES = 1000
 CHANNEL = {
     "channel.round_trip_delay_ms": 10.0,
     "channel.jitter_ms": 3.0,

@@ -8,7 +8,9 @@ import subprocess
 import pytest
 
 from conftest import tool
+from haptic_sim import teleop_cli
 from haptic_sim.teleop_cli import main
+from haptic_sim.teleop_stability import DelayPoint
 
 
 def test_json_is_one_line_of_the_session_figures(capsys) -> None:
@@ -29,12 +31,32 @@ def test_the_table_and_the_force_tracking_figure(tmp_path, capsys) -> None:
     assert (tmp_path / "fig" / "force_tracking.png").stat().st_size > 10_000
 
 
-@pytest.mark.slow
-def test_the_sweep_adds_its_table_and_figure(tmp_path, capsys) -> None:
-    argv = ["--duration", "0.5", "--sweep", "50:50:1", "--workers", "2", "--out", str(tmp_path)]
+def test_the_sweep_adds_its_table_and_figure(tmp_path, capsys, monkeypatch) -> None:
+    """The sweep's plumbing, on made-up points (the sweep itself: test_teleop_session.py)."""
+    asked = {}
+
+    def fake_sweep(base, delays, protocol, workers):
+        asked.update(delays=delays, workers=workers, delay=base.channel.round_trip_delay_ms)
+        return [
+            DelayPoint(
+                d,
+                p,
+                0.0 if p or d < 20 else 12.0,
+                -1.0 * (d >= 20 and not p),
+                0.1 * p,
+                9.0,
+                p or d < 20,
+            )
+            for p in (False, True)
+            for d in delays
+        ]
+
+    monkeypatch.setattr(teleop_cli, "delay_sweep", fake_sweep)
+    argv = ["--duration", "0.2", "--sweep", "10:30:10", "--workers", "3", "--out", str(tmp_path)]
     assert main(argv) == 0
+    assert asked == {"delays": [10.0, 20.0, 30.0], "workers": 3, "delay": 2.0}
     out = capsys.readouterr().out
-    assert "plain channel: unstable from 50 ms" in out and "TDPA: stable at every delay" in out
+    assert "plain channel: unstable from 20 ms" in out and "TDPA: stable at every delay" in out
     assert (tmp_path / "stability.png").stat().st_size > 10_000
 
 
