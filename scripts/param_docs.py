@@ -14,9 +14,11 @@ OUT = Path(__file__).resolve().parents[1] / "docs" / "parameters.md"
 
 def tables() -> list[tuple[str, str, list]]:
     """(node, ros2 run name, specs) of every node."""
+    from haptic_dob.nodes.channel_node import channel_node_specs
     from haptic_dob.nodes.controller_node import controller_node_specs
     from haptic_dob.nodes.environment_node import environment_node_specs
     from haptic_dob.nodes.observer_node import observer_node_specs
+    from haptic_dob.nodes.slave_controller_node import slave_controller_node_specs
     from haptic_sim.nodes.device_node import device_node_specs
 
     out = [
@@ -24,6 +26,12 @@ def tables() -> list[tuple[str, str, list]]:
         ("environment_node", "haptic_dob environment_node", environment_node_specs()),
         ("observer_node", "haptic_dob observer_node", observer_node_specs()),
         ("controller_node", "haptic_dob controller_node", controller_node_specs()),
+        ("channel_node", "haptic_dob channel_node", channel_node_specs()),
+        (
+            "slave_controller_node",
+            "haptic_dob slave_controller_node",
+            slave_controller_node_specs(),
+        ),
     ]
     try:
         from haptic_dob.nodes.recorder_node import recorder_specs

@@ -11,8 +11,8 @@ from typing import Any
 
 import pytest
 
+from haptic_dob.watchdog import CommandWatchdog
 from haptic_msgs_py.values import EffortCommand
-from haptic_sim.command_watchdog import CommandWatchdog
 from haptic_sim.cycle_stats import RealtimeStats
 from haptic_sim.device import DeviceSample
 from haptic_sim.device_loop import STARTUP_RESEND_S, DeviceLoop

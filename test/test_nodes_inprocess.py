@@ -8,15 +8,24 @@ from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
+from haptic_dob.nodes.channel_node import ChannelNode
 from haptic_dob.nodes.controller_node import ControllerNode
 from haptic_dob.nodes.environment_node import EnvironmentNode
 from haptic_dob.nodes.observer_node import ObserverNode
+from haptic_dob.nodes.slave_controller_node import SlaveControllerNode
 from haptic_msgs_py.values import EffortCommand, StampedVector
 from haptic_sim.nodes.device_node import DeviceNode
 from rosgraph import isolated_env
 from waits import wait_until
 
-NODES = [DeviceNode, EnvironmentNode, ObserverNode, ControllerNode]
+NODES = [
+    DeviceNode,
+    EnvironmentNode,
+    ObserverNode,
+    ControllerNode,
+    ChannelNode,
+    SlaveControllerNode,
+]
 
 
 @pytest.mark.parametrize("cls", NODES, ids=lambda c: c.__name__)

@@ -47,15 +47,23 @@ from haptic_dob.validation import nonnegative, positive, scalar_of, vector
 
 #: default observer gain c (N s/m): time constant m/c = 10 ms on the slide, corner 15.9 Hz
 DEFAULT_GAIN = 41.6
+#: the observers: the disturbance observer (this module), the generalized-momentum observer
+#: (``haptic_dob.momentum_observer``)
+OBSERVER_KINDS = ("dob", "momentum")
 
 
 @dataclass(frozen=True)
 class ObserverSettings:
-    """Observer gain and output clip, as the observer node and batch runs take them."""
+    """Observer kind, gain and output clip, as the observer node and batch runs take them."""
 
     gain: float = field(
         default=DEFAULT_GAIN,
-        metadata=param("observer gain c (N s/m prismatic, N m s/rad revolute)", "", 1e-6, 1e6),
+        metadata=param(
+            "observer gain: dob c (N s/m prismatic, N m s/rad revolute), momentum K (1/s)",
+            "",
+            1e-6,
+            1e6,
+        ),
     )
     output_limit: float = field(
         default=0.0,
@@ -67,13 +75,28 @@ class ObserverSettings:
             1e6,
         ),
     )
+    kind: str = field(
+        default="dob",
+        metadata=param(
+            "the disturbance observer (lag D/c per joint) or the generalized-momentum observer "
+            "(lag 1/gain on every joint)",
+            choices=OBSERVER_KINDS,
+            read_only=True,
+        ),
+    )
 
     def __post_init__(self) -> None:
+        if self.kind not in OBSERVER_KINDS:
+            raise ValueError(f"kind must be one of {', '.join(OBSERVER_KINDS)}, got {self.kind!r}")
         positive("gain", self.gain)
         nonnegative("output_limit", self.output_limit)
 
     def build(self, model: DeviceModel, dt: float) -> DisturbanceObserver:
         """The observer for ``model`` at period ``dt`` (s)."""
+        if self.kind == "momentum":
+            from haptic_dob.momentum_observer import MomentumObserver
+
+            return MomentumObserver(model, self.gain, dt, self.output_limit or None)
         return DisturbanceObserver(model, self.gain, dt, self.output_limit or None)
 
 
@@ -91,6 +114,7 @@ class DisturbanceObserver:
     """
 
     _z: Vec  # the state, set by reset() (N or N m)
+    _scalar_path = True  # the slide's update in floats
 
     def __init__(
         self,
@@ -111,7 +135,7 @@ class DisturbanceObserver:
         self._set_limit(self._check_limit(limit))
         self.dls_threshold_m = positive("dls_threshold_m", dls_threshold_m)
         self.dls_damping_m = positive("dls_damping_m", dls_damping_m)
-        self._scalar = isinstance(model, SlideModel)
+        self._scalar = self._scalar_path and isinstance(model, SlideModel)
         self._axis = model.axis if isinstance(model, SlideModel) else np.zeros(3)  # (3,) slide
         self._n = n
         self._eye = np.eye(n)
@@ -204,7 +228,11 @@ class DisturbanceObserver:
             d = np.zeros(self._n)
             self._initialised = True
         self._D_prev, self._h_prev = D, h
-        self._qd_last = qd_
+        return self._output(d, qd_)
+
+    def _output(self, d: Vec, qd: Vec) -> Vec:
+        """Keep sample's ``q'``, clip ``d`` to ``limit``, hold it as the estimate; a copy."""
+        self._qd_last = qd
         lim, neg = self.limit, self._neg_limit
         if lim is not None and neg is not None:
             d = np.minimum(np.maximum(d, neg), lim)

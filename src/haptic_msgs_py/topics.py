@@ -18,6 +18,8 @@ WRENCH_DESIRED = "wrench_desired"  # geometry_msgs/WrenchStamped: wall force on 
 # observer -> controller
 WRENCH_ESTIMATE = "wrench_estimate"  # geometry_msgs/WrenchStamped: estimated hand force
 EFFORT_ESTIMATE = "effort_estimate"  # sensor_msgs/JointState: estimated external joint effort
+# teleoperation: the channel's slave end -> the slave's controller
+POSE_DESIRED = "pose_desired"  # geometry_msgs/PoseStamped: the point the slave tracks
 # controller -> device
 EFFORT_COMMAND = "effort_command"  # std_msgs/Float64MultiArray, joint order
 DIAGNOSTICS = "/diagnostics"  # diagnostic_msgs/DiagnosticArray

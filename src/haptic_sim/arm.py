@@ -29,8 +29,13 @@ the end effector, ``u`` the push direction (``hand_direction``), ``r(t)`` the 1-
 device ``F_h = k_h (x_r - p) + b_h (x_r' - p') + f_ff u - m_h p''``; the hand mass enters the
 dynamics exactly (``D + m_h J^T J``, bias ``+ m_h J^T J' q'``). ``behaviour: none``: no hand.
 
+Contact (``contact``, ``haptic_sim.arm_contact``): a wall the end effector touches, its force
+evaluated at every integration stage from the stage's tip point and velocity and added to the
+external force; ``contact_force_true`` is its value at the sample's true state, and the sample's
+``hand_force`` then carries the external force at that state (a teleoperation slave's true contact).
+
 Force sensor: three ``ForceSensor`` axes (noise, first-order bandwidth, bias) at the handle,
-reading the total external force on the end effector (hand plus external force).
+reading the total external force on the end effector (hand, external force and contact).
 """
 
 from __future__ import annotations
@@ -41,9 +46,11 @@ from typing import cast
 
 import numpy as np
 
+from haptic_dob.environment import VirtualWall
 from haptic_dob.models.base import DeviceModel, Vec
 from haptic_dob.validation import positive, unit_vector, vector
 from haptic_msgs_py.stamps import period_ns
+from haptic_sim.arm_contact import contact_of
 from haptic_sim.arm_dynamics import coulomb_smoothing, dynamics_and_tip, mass_and_bias, solve
 from haptic_sim.arm_params import ArmDeviceParams
 from haptic_sim.device import DeviceSample
@@ -72,6 +79,7 @@ class SimulatedArm:
         rate_hz: control rate (Hz), > 0.
         substeps: RK4 steps per control period, >= 1.
         seed: seed of the hand's reference and the sensor noise.
+        contact: a wall the end effector touches (None, or zero stiffness: none).
     """
 
     def __init__(
@@ -83,6 +91,7 @@ class SimulatedArm:
         rate_hz: float = 1000.0,
         substeps: int = 10,
         seed: int = 0,
+        contact: VirtualWall | None = None,
     ) -> None:
         if not isinstance(model, DeviceModel):
             raise ValueError(f"model must be a DeviceModel, got {type(model).__name__}")
@@ -138,7 +147,9 @@ class SimulatedArm:
                 for rng, e in ((rngs[1], self._e1), (rngs[2], self._e2)):
                     self._ref.append((HandReference(lateral, self.dt_physics, rng), e))
         self._sensors = [ForceSensor(self.sensor_params, self.dt_physics, r) for r in rngs[3:]]
-        self._needs_tip = h.active or self._ext_on_step is not None
+        self.contact = contact_of(contact)
+        self._contact = None if self.contact is None else self.contact.force
+        self._needs_tip = h.active or self._ext_on_step is not None or self.contact is not None
         self._kh, self._bh = h.stiffness_n_per_m, h.damping_n_s_per_m
         self._mh = h.mass_kg if h.active else 0.0
         self._exact_velocity = dev.velocity == "exact"
@@ -150,7 +161,8 @@ class SimulatedArm:
         self.accel = np.zeros(n)
         self.p0 = model._forward_kinematics(self.q)
         self.hand_force_true = np.zeros(3)  # the hand's force on the handle (N)
-        self.tip_force_true = np.zeros(3)  # hand + external force on the end effector (N)
+        self.tip_force_true = np.zeros(3)  # hand + external force + contact on the tip (N)
+        self.contact_force_true = np.zeros(3)  # the contact's force at the sample's state (N)
         self._effort_applied = np.zeros(n)
         self._q_enc = self._encode(self.q)
         self._q_enc_prev = self._q_enc
@@ -183,6 +195,11 @@ class SimulatedArm:
             raise ValueError(f"effort must be finite, got {list(effort)!r}")
         u = np.minimum(np.maximum(u, self._neg_lim), self._lim)
         self._integrate(u)
+        if self.contact is not None:  # the contact at the sample's true state, for evaluation
+            c = self.contact.force_at(self.model, self.q, self.v)
+            on = self._ext_on_step is not None and self._i_phys > self._ext_on_step
+            self.tip_force_true = self.hand_force_true + c + (self._f_ext if on else _ZERO3)
+            self.contact_force_true = c
         self._effort_applied = u
         self._k += 1
         self._q_enc_prev = self._q_enc
@@ -209,6 +226,8 @@ class SimulatedArm:
             D, h = self._dyn(q, v)
             return solve(D, tau - h)
         D, h, p, J, jdv = self._dyn_tip(q, v)
+        if self._contact is not None:
+            f_ext = f_ext + self._contact(p, J @ v)
         Jt = J.T
         if ref is None:
             self._last = (_ZERO3, J, jdv, f_ext)

@@ -20,10 +20,10 @@ from collections.abc import Callable, Mapping
 from typing import Any, Protocol
 
 from haptic_dob.command_guard import CommandGuard
+from haptic_dob.watchdog import CommandWatchdog
 from haptic_msgs_py.topics import EFFORT_COMMAND
 from haptic_msgs_py.values import EffortCommand
 from haptic_sim.arm import SimulatedArm
-from haptic_sim.command_watchdog import CommandWatchdog
 from haptic_sim.cycle_stats import CycleStats, RealtimeStats
 from haptic_sim.device import DeviceSample
 from haptic_sim.device_settings import DeviceLoopSettings

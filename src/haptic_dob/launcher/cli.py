@@ -18,6 +18,9 @@ Network: by default every node's discovery stays on this host
 by accident. ``--network subnet`` lets them discover across the subnet, ``--peers`` adds named
 hosts (``ROS_STATIC_PEERS``), and ``--only`` starts a subset: the device on one host and the rest
 on another (see docs/running.md, "Lab network and security").
+
+A teleoperation YAML (``/master/...`` and ``/slave/...`` sections) starts the two sides' nodes in
+their namespaces, composed in one process by default (``haptic_dob.launcher.teleop``).
 """
 
 from __future__ import annotations
@@ -45,13 +48,19 @@ from haptic_dob.launcher.options import (
 )
 from haptic_dob.launcher.process_plan import check_pinnable, groups_for, plan, select
 from haptic_dob.launcher.supervise import check_cpu_latency_request, launch, set_rt_priority
+from haptic_dob.launcher.teleop import teleop_command
 from haptic_dob.nodes.registry import START_ORDER
+from haptic_dob.runtime.params import load_sections
+from haptic_dob.teleop.graph import is_teleop, load_teleop_sections
 
 
 def command(opts: LaunchOptions) -> int:
     """Resolve, plan and run; raises ``CliError`` on bad input."""
-    namespace = normalize_namespace(opts.namespace)
     path = resolve_config(opts.config)
+    sections = load_sections(path)
+    if is_teleop(sections):
+        return teleop_command(opts, load_teleop_sections(path))
+    namespace = normalize_namespace(opts.namespace)
     params = resolved_params(path, parse_sets(opts.sets))
     if opts.record:
         add_recorder(params, opts.record, opts.record_storage)

@@ -64,7 +64,7 @@ def launch(
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     procs: dict[str, subprocess.Popen[bytes]] = {}
     labels = {s.name: s.label for s in specs}
-    device = next((s.name for s in specs if "device_node" in s.nodes), None)
+    devices = {s.name for s in specs if any(n.rsplit("/", 1)[-1] == "device_node" for n in s.nodes)}
     code = 0
     try:
         for spec in specs:
@@ -78,7 +78,7 @@ def launch(
             done = {n: p.returncode for n, p in procs.items() if p.poll() is not None}
             if done:
                 name, rc = next(iter(done.items()))
-                if name == device and rc == 0:
+                if name in devices and rc == 0:
                     print(
                         "haptic-launch: device_node finished its run; stopping the graph",
                         file=sys.stderr,
@@ -94,20 +94,20 @@ def launch(
                 break
             time.sleep(0.05)
     finally:
-        _stop_all(procs, stop_timeout, device)
+        _stop_all(procs, stop_timeout, devices)
         for s, h in old.items():
             signal.signal(s, h)
     return code
 
 
-def _stop_all(procs: dict[str, subprocess.Popen[bytes]], timeout: float, first: str | None) -> None:
-    """SIGTERM to every live process (``first``'s first), wait up to ``timeout`` s, then SIGKILL
-    what is left.
+def _stop_all(procs: dict[str, subprocess.Popen[bytes]], timeout: float, first: set[str]) -> None:
+    """SIGTERM to every live process (the ``first`` ones first: the devices), wait up to
+    ``timeout`` s, then SIGKILL what is left.
 
     A node that runs handles SIGTERM as Ctrl-C (``run_nodes``); one still importing its modules
     ends quietly, where SIGINT would print a ``KeyboardInterrupt`` traceback.
     """
-    order = sorted(procs, key=lambda n: n != first)
+    order = sorted(procs, key=lambda n: n not in first)
     for name in order:
         p = procs[name]
         if p.poll() is None:

@@ -191,6 +191,20 @@ class PinocchioModel(DeviceModel):
             h += self._friction(qd)
         return D, h
 
+    def _mass_and_momentum_bias(self, q: Vec, qd: Vec) -> tuple[Mat, Vec]:
+        """D(q) and ``G + friction - C^T q'`` from pinocchio's Coriolis matrix (mimic joints,
+        which it refuses: ``DeviceModel``'s differences)."""
+        if self._mimic:
+            return super()._mass_and_momentum_bias(q, qd)
+        m, d = self._model, self._data
+        qt, vt = self._conf(q), self._vel(qd)
+        C = pin.computeCoriolisMatrix(m, d, qt, vt)
+        beta = self._effort(pin.computeGeneralizedGravity(m, d, qt) - C.T @ vt)
+        D = self._ours(pin.crba(m, d, qt))
+        if self._has_friction:
+            beta += self._friction(qd)
+        return D, beta
+
     def inverse_dynamics(self, q: Vec, qd: Vec, qdd: Vec) -> Vec:
         """The effort ``D q'' + C q' + G + friction`` that moves the arm so (RNEA, validated)."""
         q_, qd_, qdd_ = self._q(q), self._qd(qd), self._qd(qdd)

@@ -84,6 +84,20 @@ class DeviceModel(ABC):
     def _bias_effort(self, q: Vec, qd: Vec) -> Vec:
         return self._coriolis_vector(q, qd) + self._gravity(q) + self._friction(qd)
 
+    def _mass_and_momentum_bias(self, q: Vec, qd: Vec) -> tuple[Mat, Vec]:
+        """D(q) and the momentum observer's bias ``G + friction - C^T q'`` (``p' = tau + d -
+        bias``, ``p = D q'``): ``h - D' q'`` with ``D' q'`` by central differences along ``q'``
+        (``D' = C + C^T``). Models with a Coriolis matrix at hand compute it directly."""
+        D = self._mass_matrix(q)
+        h = self._bias_effort(q, qd)
+        speed = float(np.linalg.norm(qd))
+        if speed == 0.0:
+            return D, h
+        eps = 1e-6 / speed
+        dD = (self._mass_matrix(q + eps * qd) - self._mass_matrix(q - eps * qd)) / (2.0 * eps)
+        bias: Vec = h - dD @ qd
+        return D, bias
+
     # --- helpers -------------------------------------------------------------------------------
     def _q(self, q: ArrayLike) -> Vec:
         return vector("q", q, self.dof)

@@ -4,7 +4,8 @@ The nodes are the same nodes as their own executables start (parameters, service
 topics), with their default names, under one executor; the loop's messages between them are
 handed over in process (``haptic_msgs_py.bus``) and reach DDS only for readers elsewhere.
 ``--ros-args`` apply to every node (a params file keyed by node name, ``-r __ns:=``; not
-``__node``, which would give them all one name).
+``__node``, which would give them all one name). A node named ``NS/NODE`` runs in namespace
+``/NS`` (a teleoperation graph: ``master/device_node slave/device_node ...``).
 """
 
 from __future__ import annotations
@@ -19,20 +20,26 @@ USAGE = (
 )
 
 
+def split_name(item: str) -> tuple[str | None, str]:
+    """``NS/NODE`` -> (``/NS``, ``NODE``); ``NODE`` -> (None, ``NODE``)."""
+    ns, _, node = item.rpartition("/")
+    return ("/" + ns.strip("/") if ns else None), node
+
+
 def parse(argv: list[str]) -> tuple[list[str], list[str]]:
     """(node names in start order, the ROS arguments); ``ValueError`` with the reason."""
     split = argv.index("--ros-args") if "--ros-args" in argv else len(argv)
     names, ros_args = argv[:split], argv[split:]
     if not names:
         raise ValueError("name at least one node to run")
-    unknown = [n for n in names if n not in NODES]
+    unknown = [n for n in names if split_name(n)[1] not in NODES]
     if unknown:
         raise ValueError(f"unknown node(s) {', '.join(unknown)}; nodes: {', '.join(NODES)}")
     if len(set(names)) != len(names):
         raise ValueError(f"a node is named twice: {' '.join(names)}")
     if any(a.startswith("__node:=") for a in ros_args):
         raise ValueError("__node:= would give every node one name; the nodes keep their own")
-    return sorted(names, key=START_ORDER.index), ros_args
+    return sorted(names, key=lambda n: START_ORDER.index(split_name(n)[1])), ros_args
 
 
 def main(args: list[str] | None = None) -> int:
@@ -43,7 +50,7 @@ def main(args: list[str] | None = None) -> int:
         return 0
     try:
         names, ros_args = parse(argv)
-        classes = [(n, node_class(n)) for n in names]
+        classes = [(*split_name(n), node_class(split_name(n)[1])) for n in names]
     except ValueError as exc:
         print(f"ERROR: {exc}", file=sys.stderr)
         return 2
@@ -52,7 +59,7 @@ def main(args: list[str] | None = None) -> int:
 
     ensure_ament_prefix()
     return run_nodes(
-        lambda ctx: [cls(context=ctx, name=name) for name, cls in classes],
+        lambda ctx: [cls(context=ctx, name=name, namespace=ns) for ns, name, cls in classes],
         ["container", *ros_args],
     )
 

@@ -97,8 +97,13 @@ def controller_node_specs() -> list[ParamSpec]:
 class ControllerNode(LoopNode):
     """Computes command k from the stamp-k inputs its mode needs (``haptic_dob.command_join``)."""
 
-    def __init__(self, context: Context | None = None, name: str = "controller_node") -> None:
-        super().__init__(name, context=context)
+    def __init__(
+        self,
+        context: Context | None = None,
+        name: str = "controller_node",
+        namespace: str | None = None,
+    ) -> None:
+        super().__init__(name, context=context, namespace=namespace)
         self.params = ParameterTable(self, controller_node_specs(), self._settings, self._apply)
         values = self.params.values
         self.model = build_model(values)

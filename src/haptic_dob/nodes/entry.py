@@ -20,6 +20,16 @@ def controller_node() -> int:
     return run_main("haptic_dob.nodes.controller_node")
 
 
+def channel_node() -> int:
+    """``haptic-channel-node``."""
+    return run_main("haptic_dob.nodes.channel_node")
+
+
+def slave_controller_node() -> int:
+    """``haptic-slave-controller-node``."""
+    return run_main("haptic_dob.nodes.slave_controller_node")
+
+
 def recorder_node() -> int:
     """``haptic-recorder-node``."""
     return run_main("haptic_dob.nodes.recorder_node")

@@ -50,8 +50,13 @@ class Environment(NamedTuple):
 class EnvironmentNode(LoopNode):
     """Renders a wall (or a two-sided spring) and a known excitation; both change at run time."""
 
-    def __init__(self, context: Context | None = None, name: str = "environment_node") -> None:
-        super().__init__(name, context=context)
+    def __init__(
+        self,
+        context: Context | None = None,
+        name: str = "environment_node",
+        namespace: str | None = None,
+    ) -> None:
+        super().__init__(name, context=context, namespace=namespace)
         self.params = ParameterTable(self, environment_node_specs(), self._settings, self._apply)
         self.wall, self.excitation = self.params.settings
         self._adds = self.excitation if self.excitation.active else None  # what wall_force adds

@@ -42,8 +42,13 @@ def observer_node_specs() -> list[ParamSpec]:
 class ObserverNode(LoopNode):
     """Publishes the estimated contact wrench and external joint effort of any device model."""
 
-    def __init__(self, context: Context | None = None, name: str = "observer_node") -> None:
-        super().__init__(name, context=context)
+    def __init__(
+        self,
+        context: Context | None = None,
+        name: str = "observer_node",
+        namespace: str | None = None,
+    ) -> None:
+        super().__init__(name, context=context, namespace=namespace)
         self.params = ParameterTable(self, observer_node_specs(), self._settings, self._apply)
         values = self.params.values
         self.model: DeviceModel = build_model(values)

@@ -27,6 +27,8 @@ START_ORDER = (
     "environment_node",
     "observer_node",
     "controller_node",
+    "channel_node",
+    "slave_controller_node",
     "device_node",
 )
 

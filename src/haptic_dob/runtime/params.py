@@ -218,12 +218,12 @@ def flatten(tree: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     return out
 
 
-def load_node_params(path: Any) -> dict[str, dict[str, Any]]:
-    """A ``ros__parameters`` YAML file as ``{node name or "/**": {dotted name: value}}``.
+def load_sections(path: Any) -> dict[str, dict[str, Any]]:
+    """A ``ros__parameters`` YAML file as ``{section key: {dotted name: value}}``, the keys as
+    written (``/**``, ``/**/device_node``, ``/master/device_node``...).
 
-    Node keys may be fully qualified (``/ns/device_node``, ``/**/device_node``); the last part is
-    the name. Raises ``ValueError`` (one line) when the file is not such a file; ``OSError`` when
-    it cannot be read.
+    Raises ``ValueError`` (one line) when the file is not such a file; ``OSError`` when it cannot
+    be read.
     """
     import yaml
 
@@ -237,12 +237,24 @@ def load_node_params(path: Any) -> dict[str, dict[str, Any]]:
         raise ValueError(f"{path} must map node names to ros__parameters")
     out: dict[str, dict[str, Any]] = {}
     for key, body in doc.items():
-        name = "/**" if key == "/**" else str(key).rsplit("/", 1)[-1]
         params = body.get("ros__parameters") if isinstance(body, dict) else None
         if not isinstance(params, dict):
             raise ValueError(f"{path}: section {key!r} has no ros__parameters mapping")
-        out[name] = flatten(params)
+        out[str(key)] = flatten(params)
     return out
+
+
+def load_node_params(path: Any) -> dict[str, dict[str, Any]]:
+    """A ``ros__parameters`` YAML file as ``{node name or "/**": {dotted name: value}}``.
+
+    Node keys may be fully qualified (``/ns/device_node``, ``/**/device_node``); the last part is
+    the name. Raises ``ValueError`` (one line) when the file is not such a file; ``OSError`` when
+    it cannot be read.
+    """
+    return {
+        ("/**" if key == "/**" else key.rsplit("/", 1)[-1]): params
+        for key, params in load_sections(path).items()
+    }
 
 
 def node_view(nodes: Mapping[str, Mapping[str, Any]], name: str) -> dict[str, Any]:

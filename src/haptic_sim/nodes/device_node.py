@@ -66,8 +66,13 @@ from haptic_sim.factory import build_device
 class DeviceNode(LoopNode):
     """A simulated device stepping in the cycle contract (``DeviceLoop``) on the ROS graph."""
 
-    def __init__(self, context: Context | None = None, name: str = "device_node") -> None:
-        super().__init__(name, context=context)
+    def __init__(
+        self,
+        context: Context | None = None,
+        name: str = "device_node",
+        namespace: str | None = None,
+    ) -> None:
+        super().__init__(name, context=context, namespace=namespace)
         self.params = ParameterTable(self, device_node_specs())
         v = self.params.values
         self.device = build_device(v)

@@ -1,4 +1,5 @@
-"""The real-time device's watchdog: zero effort when valid commands stop, counted in samples.
+"""The watchdog, counted in samples: the real-time device's (zero effort when valid commands stop)
+and each end of the teleoperation channel's (``haptic_dob.teleop.delay``: a silent peer).
 
 The simulated plant moves only when the device ticks, so the watchdog counts the plant's samples,
 not the wall clock: a stall of the device's own process (the host, the garbage collector) never

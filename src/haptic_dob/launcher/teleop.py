@@ -1,0 +1,119 @@
+"""``haptic-launch`` of a teleoperation YAML: the master's and the slave's nodes in their
+namespaces (``haptic_dob.teleop.graph``), composed in one process by default.
+
+A YAML with ``/master/...`` or ``/slave/...`` sections is a teleoperation graph: each node's
+parameters are its sections overlaid (``node_values``), written to a params file under the
+node's full name; ``--set NS/NODE:PARAM=VALUE`` overrides one node's, ``**/NODE:`` the node of
+both sides. ``--composed`` (the default) runs all nodes in one container (their messages handed
+over in process), ``--processes`` one process each; the options of a single loop's launch
+(``--namespace``, ``--group``, ``--only``, ``--record``, ``--pin``, ``--cpu-latency``) are refused.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from haptic_dob.cli import CliError
+from haptic_dob.launcher.options import LaunchOptions, network_env
+from haptic_dob.launcher.process_plan import ProcessSpec, executable
+from haptic_dob.launcher.supervise import launch, set_rt_priority
+from haptic_dob.nodes.registry import CONTAINER, NODES
+from haptic_dob.teleop.graph import NAMESPACES, check_sections, graph_nodes, node_values
+
+
+def teleop_params(
+    sections: Mapping[str, Mapping[str, Any]], sets: Sequence[str]
+) -> dict[str, dict[str, Any]]:
+    """``{"master/device_node": {param: value}, ...}`` for every node, ``--set`` applied."""
+    try:
+        check_sections(sections)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    out = {f"{ns}/{node}": node_values(sections, ns, node) for ns, node in graph_nodes()}
+    for item in sets:
+        target, sep, assignment = item.partition(":")
+        param, eq, text = assignment.partition("=")
+        ns, _, node = target.partition("/")
+        names = [f"{n}/{node}" for n in NAMESPACES] if ns == "**" else [target]
+        names = [n for n in names if n in out]
+        if not (sep and eq and param and names):
+            raise CliError(
+                f"--set needs NS/NODE:PARAM=VALUE with a node of the graph ({', '.join(out)}; "
+                f"**/NODE for both sides), got {item!r}"
+            )
+        try:
+            value = yaml.safe_load(text)
+        except yaml.YAMLError:
+            raise CliError(f"--set {item!r}: the value is not valid YAML") from None
+        for name in names:
+            out[name][param] = value
+    return out
+
+
+class _Plain(yaml.SafeDumper):  # type: ignore[misc]  # PyYAML ships without stubs here
+    """YAML without anchors: rcl's parser refuses aliases (nodes share values, such as lists)."""
+
+    def ignore_aliases(self, data: Any) -> bool:
+        return True
+
+
+def write_teleop_params(params: Mapping[str, Mapping[str, Any]], directory: Path) -> Path:
+    """The params file: every node's parameters under its full name (``/master/device_node``)."""
+    doc = {f"/{name}": {"ros__parameters": dict(values)} for name, values in params.items()}
+    path = directory / "params.yaml"
+    path.write_text(yaml.dump(doc, Dumper=_Plain, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def teleop_plan(params: Mapping[str, Any], params_file: Path, processes: bool) -> list[ProcessSpec]:
+    """One container for every node, or (``processes``) a process per node, devices last."""
+    ros = ["--ros-args", "--params-file", str(params_file)]
+    names = list(params)
+    if not processes:
+        return [ProcessSpec(", ".join(names), names, executable(*CONTAINER), [*names, *ros])]
+    out = []
+    for name in names:
+        ns, _, node = name.partition("/")
+        entry = NODES[node]
+        args = [*ros, "-r", f"__ns:=/{ns}", "-r", f"__node:={node}"]
+        out.append(ProcessSpec(name, [name], executable(entry.package, entry.executable), args))
+    return out
+
+
+REFUSED = {
+    "namespace": "--namespace",
+    "groups": "--group",
+    "only": "--only",
+    "record": "--record",
+    "pin": "--pin",
+    "cpu_latency_us": "--cpu-latency",
+}
+
+
+def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]]) -> int:
+    """Plan and run a teleoperation graph; ``CliError`` on bad input."""
+    given = [flag for field, flag in REFUSED.items() if getattr(opts, field)]
+    if given:
+        raise CliError(
+            f"{', '.join(given)}: not for a teleoperation graph (its namespaces are "
+            "/master and /slave)"
+        )
+    if opts.composed and opts.processes:
+        raise CliError("--composed and --processes are different choices: pick one")
+    params = teleop_params(sections, opts.sets)
+    net = network_env(opts.network, opts.peers)
+    if opts.rt_priority is not None:
+        set_rt_priority(opts.rt_priority)
+    if opts.executor:
+        net["HAPTIC_DOB_EXECUTOR"] = opts.executor
+    with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
+        specs = teleop_plan(params, write_teleop_params(params, Path(tmp)), opts.processes)
+        if len(specs) == 1:
+            print(f"haptic-launch: {specs[0].name} in one process", file=sys.stderr)
+        return launch(specs, opts.stop_timeout, opts.duration, net)

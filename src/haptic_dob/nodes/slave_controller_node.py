@@ -1,0 +1,120 @@
+"""slave_controller_node: a teleoperation slave's joint impedance. joint_states k + pose_desired
+k -> effort_command k.
+
+Runs ``haptic_dob.teleop.slave.SlaveController``: a differential-IK step moves the joint target
+toward ``pose_desired`` (the point the channel's slave end wants the tool at), and the joint
+impedance around it plus the model's gravity gives the efforts, saturated at the model's limits.
+Command k goes out once both inputs of stamp k are here, labelled with the stamp; a sample
+answered already is answered again with the same command (a lockstep re-send). The gains are
+set at the first sample's pose (``slave.*``, read-only).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+from rclpy.context import Context
+
+from haptic_dob.models.factory import build_model, model_specs
+from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
+from haptic_dob.nodes.observer_node import JointMap, pick
+from haptic_dob.runtime.params import ParamSpec, build, specs_of
+from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
+from haptic_dob.runtime.ros.params import ParameterTable
+from haptic_dob.runtime.ros.spin import LoopNode
+from haptic_dob.teleop.slave import SlaveController, SlaveImpedance
+from haptic_msgs_py import codecs
+from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
+from haptic_msgs_py.topics import EFFORT_COMMAND, JOINT_STATES, POSE_DESIRED
+from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
+
+
+def slave_controller_node_specs() -> list[ParamSpec]:
+    """Every parameter of the slave controller node."""
+    return [
+        *loop_specs(),
+        *input_specs("best_effort"),
+        *process_specs(),
+        *model_specs(),
+        *specs_of(SlaveImpedance, "slave.", read_only=True),
+    ]
+
+
+class SlaveControllerNode(LoopNode):
+    """Tracks ``pose_desired`` with the slave's joint impedance (``SlaveController``)."""
+
+    def __init__(
+        self,
+        context: Context | None = None,
+        name: str = "slave_controller_node",
+        namespace: str | None = None,
+    ) -> None:
+        super().__init__(name, context=context, namespace=namespace)
+        self.params = ParameterTable(self, slave_controller_node_specs())
+        v = self.params.values
+        model = build_model(v)
+        self.controller = SlaveController(
+            model, build(SlaveImpedance, v, "slave."), round(1e9 / v["rate_hz"]) * 1e-9
+        )
+        self.joints = JointMap(model.joint_names)
+        self._q: tuple[int, list[float], list[float]] | None = None
+        self._target: StampedVector | None = None
+        self._last: EffortCommand | None = None
+        self._pub = LoopPublisher(self, EFFORT_COMMAND, codecs.EFFORT, qos.LOOP)
+        inputs = qos.loop_input(v["input_reliability"])
+        LoopSubscription(self, JOINT_STATES, codecs.JOINT_STATE, self._on_joints, inputs)
+        LoopSubscription(self, POSE_DESIRED, codecs.POSE, self._on_target, inputs)
+        self.diagnostics = Diagnostics(self, self._report)
+
+    def _on_joints(self, js: JointSample) -> None:
+        try:
+            idx = self.joints.index(js.name, len(js.position))
+            n = len(js.name) or len(js.position)
+            q = pick(js.position, idx, "position", n)
+            qd = pick(js.velocity, idx, "velocity", n)
+        except ValueError as exc:
+            self.get_logger().error(f"ignoring joint_states: {exc}", throttle_duration_sec=5.0)
+            return
+        self._q = (js.stamp_ns, q, qd)
+        self._step()
+
+    def _on_target(self, target: StampedVector) -> None:
+        self._target = target
+        self._step()
+
+    def _step(self) -> None:
+        joints, target = self._q, self._target
+        if joints is None or target is None or joints[0] != target.stamp_ns:
+            return
+        k = target.stamp_ns
+        last = self._last
+        if last is not None and k <= (last.stamp_ns or 0):
+            if k == last.stamp_ns:
+                self._pub.publish(last)  # the same sample again: the same command
+            return
+        _, q, qd = joints
+        tau = self.controller.command(np.asarray(q), np.asarray(qd), target.vector)
+        self._last = EffortCommand(k, tuple(tau))
+        self._pub.publish(self._last)
+        self.diagnostics.tick()
+
+    def next_sample_ns(self) -> int | None:
+        """No parameter changes at run time (all read-only)."""
+        return None
+
+    def _report(self) -> Report:
+        values = {"commands": self.diagnostics.cycles}
+        if self.diagnostics.rate_hz == 0.0:
+            return WARN, "no joint_states/pose_desired pairs in the last second", values
+        return OK, "tracking", values
+
+
+def main(args: list[str] | None = None) -> int:
+    """``ros2 run haptic_dob slave_controller_node``."""
+    return main_for(SlaveControllerNode, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,196 @@
+"""The two ends of the teleoperation channel: what the master's side and the slave's side compute
+each cycle from their own sample and the newest message of the other side.
+
+``MasterEnd.cycle``: the master's point and velocity of sample k -> the force the master renders
+(its controller's wall force ``F_w``) and the message to the slave. ``SlaveEnd.cycle``: the
+slave's point, velocity and contact force (estimated or measured) of sample k -> the point the
+slave tracks and the message to the master. Messages (``PortMessage``) carry slave units (the
+slave's base frame, m, m/s, N) and the energy that came into the channel at the sender's port;
+each end hands the other's messages to its ``DelayLine`` (``receive``), so only messages of
+earlier samples are ever used and the two ends may run in any order, in one process or two.
+
+Both ends book their port's energy and, with ``channel.passivity``, enforce it
+(``haptic_dob.teleop.passivity``). The master's port: flow the master's velocity, effort the
+force it renders (scaled to slave units). The slave's port: flow the velocity of the point it is
+told to track, effort the slave's contact force. When its peer is silent for ``timeout_s`` a side
+stops using it: the master renders zero force, the slave holds the point where it is (and goes on
+from there, without a jump, when messages come again).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import NamedTuple
+
+from haptic_dob.control import ZERO_FORCE, Force
+from haptic_dob.teleop.delay import DelayLine, _quiet
+from haptic_dob.teleop.passivity import PassivityPort
+from haptic_dob.teleop.settings import ChannelSettings, TeleopSettings
+
+Vec3 = tuple[float, float, float]
+
+
+class PortMessage(NamedTuple):
+    """One side's port at sample ``stamp_ns`` (slave units): displacement from the side's start
+    point (m), velocity (m/s), force (N) and the energy that came into the channel there (J)."""
+
+    stamp_ns: int
+    position: Vec3
+    velocity: Vec3
+    force: Vec3
+    energy_in_j: float
+
+
+def _rotate(R: tuple[Vec3, Vec3, Vec3], s: float, v: Vec3) -> Vec3:
+    """``s R v``."""
+    a, b, c = R
+    x, y, z = v
+    return (
+        s * (a[0] * x + a[1] * y + a[2] * z),
+        s * (b[0] * x + b[1] * y + b[2] * z),
+        s * (c[0] * x + c[1] * y + c[2] * z),
+    )
+
+
+class _End:
+    """What both ends share: the incoming line, the port's energy book, the mapping."""
+
+    def __init__(
+        self,
+        teleop: TeleopSettings,
+        channel: ChannelSettings,
+        period_ns: int,
+        salt: int,
+        lost: Callable[[str], None],
+        back: Callable[[], None],
+    ) -> None:
+        self.teleop = teleop
+        self.period_ns = period_ns
+        self.dt = period_ns * 1e-9
+        self.line: DelayLine[PortMessage] = DelayLine(channel, period_ns, salt, lost, back)
+        self.port = PassivityPort(self.dt, channel.passivity)
+        self.origin: Vec3 | None = None  # the side's point at its first sample (m)
+        self.peer_silent = False
+
+    def receive(self, message: PortMessage) -> None:
+        """A message of the other side came (in the order of its stamps)."""
+        self.line.push(message.stamp_ns, message)
+
+    def ready(self, stamp_ns: int) -> bool:
+        """Lockstep: every message that can be due by this sample has come."""
+        return self.line.complete(stamp_ns // self.period_ns)
+
+    def _incoming(self, k: int) -> PortMessage | None:
+        """The newest message due by sample ``k``, None while the peer is silent."""
+        msg = self.line.take(k)
+        if msg is not None:
+            self.port.received(msg.energy_in_j)
+        self.peer_silent = self.line.silent(k)
+        return None if self.peer_silent else msg
+
+
+class MasterEnd(_End):
+    """The master's end: renders the slave's side as the master's wall force.
+
+    Args:
+        teleop: architecture, mapping, coupling.
+        channel: the channel's settings (delay, jitter, loss, timeout, passivity).
+        period_ns: the sample period (ns).
+        axis: a 1-DOF master's axis (its frame): the rendered force is taken along it.
+        lost, back: told when the slave falls silent and when it is back.
+    """
+
+    def __init__(
+        self,
+        teleop: TeleopSettings,
+        channel: ChannelSettings,
+        period_ns: int,
+        axis: Vec3 | None = None,
+        lost: Callable[[str], None] = _quiet,
+        back: Callable[[], None] = _quiet,
+    ) -> None:
+        super().__init__(teleop, channel, period_ns, 1, lost, back)
+        m = teleop.matrix
+        self._R: tuple[Vec3, Vec3, Vec3] = tuple(tuple(r) for r in m.tolist())  # type: ignore[assignment]  # 3x3
+        self._Rt: tuple[Vec3, Vec3, Vec3] = tuple(tuple(r) for r in m.T.tolist())  # type: ignore[assignment]  # 3x3
+        self.axis = axis
+        self.force_sent: Force = ZERO_FORCE  # the port's force this cycle (slave units, N)
+
+    def cycle(self, stamp_ns: int, position: Vec3, velocity: Vec3) -> tuple[Force, PortMessage]:
+        """Sample k's point (m) and velocity (m/s), master frame -> the wall force the master
+        renders (N, master frame) and the message to the slave."""
+        t = self.teleop
+        if self.origin is None:
+            self.origin = position
+        o = self.origin
+        disp = (position[0] - o[0], position[1] - o[1], position[2] - o[2])
+        x = _rotate(self._R, t.position_scale, disp)
+        v = _rotate(self._R, t.position_scale, velocity)
+        msg = self._incoming(stamp_ns // self.period_ns)
+        if msg is None:
+            f: Force = ZERO_FORCE
+        elif t.architecture == "position_force":
+            f = msg.force
+        else:
+            k, b = t.coupling_n_per_m, t.coupling_n_s_per_m
+            p, w = msg.position, msg.velocity
+            f = (
+                k * (p[0] - x[0]) + b * (w[0] - v[0]),
+                k * (p[1] - x[1]) + b * (w[1] - v[1]),
+                k * (p[2] - x[2]) + b * (w[2] - v[2]),
+            )
+        f = self.port.impedance(f, v)
+        self.force_sent = f
+        fw = _rotate(self._Rt, t.force_scale, f)
+        a = self.axis
+        if a is not None:
+            s = fw[0] * a[0] + fw[1] * a[1] + fw[2] * a[2]
+            fw = (s * a[0], s * a[1], s * a[2])
+        return fw, PortMessage(stamp_ns, x, v, f, self.port.e_in)
+
+
+class SlaveEnd(_End):
+    """The slave's end: the point the slave tracks, from the master's delayed displacement.
+
+    Args as ``MasterEnd`` (no axis); ``lost``/``back`` tell about the master.
+    """
+
+    def __init__(
+        self,
+        teleop: TeleopSettings,
+        channel: ChannelSettings,
+        period_ns: int,
+        lost: Callable[[str], None] = _quiet,
+        back: Callable[[], None] = _quiet,
+    ) -> None:
+        super().__init__(teleop, channel, period_ns, 0, lost, back)
+        self.target: Vec3 = ZERO_FORCE  # the point the slave tracks (m, slave frame)
+        self._disp: Vec3 = ZERO_FORCE  # the master's displacement the target last followed
+        self.holding = False
+
+    def cycle(
+        self, stamp_ns: int, position: Vec3, velocity: Vec3, force: Force
+    ) -> tuple[Vec3, PortMessage]:
+        """Sample k's point (m), velocity (m/s) and contact force (N), slave frame -> the point
+        to track and the message to the master."""
+        if self.origin is None:
+            self.origin = self.target = position
+        msg = self._incoming(stamp_ns // self.period_ns)
+        if self.peer_silent:
+            if not self.holding:  # hold where it is
+                self.holding = True
+                self.target = position
+            self.port.admittance(ZERO_FORCE, force)  # no flow: books nothing
+        else:
+            self.holding = False
+            d = msg.position if msg is not None else self._disp
+            d0 = self._disp
+            T = self.dt
+            v = ((d[0] - d0[0]) / T, (d[1] - d0[1]) / T, (d[2] - d0[2]) / T)
+            v = self.port.admittance(v, force)
+            p = self.target
+            self.target = (p[0] + v[0] * T, p[1] + v[1] * T, p[2] + v[2] * T)
+            self._disp = d
+        o = self.origin
+        disp = (position[0] - o[0], position[1] - o[1], position[2] - o[2])
+        return self.target, PortMessage(stamp_ns, disp, velocity, force, self.port.e_in)

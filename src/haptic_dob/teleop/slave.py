@@ -1,0 +1,162 @@
+"""The slave arm's law: a joint impedance around a joint target that follows a Cartesian point.
+
+Per cycle, with the joint state of sample k and the point ``x_d`` to track (m, base frame):
+
+1. one damped-least-squares step of differential inverse kinematics moves the joint target
+   ``q_d`` toward ``x_d``: ``dq = J# (x_d - p(q_d)) + (I - J# J) k_n (q_0 - q_d)``,
+   ``J# = J^T (J J^T + lambda^2 I)^-1`` at ``q_d``, the second term pulling the redundant joints
+   toward the start posture ``q_0`` in the null space; ``dq`` is limited to
+   ``max_joint_speed_rad_s`` per period;
+2. ``tau = K (q_d - q) - B q' + G(q)`` (gravity of the controller's model), saturated per joint
+   at the model's effort limits (``haptic_dob.control.saturate``).
+
+The gains are matrices shaped by the inertia at the start pose: ``K = D(q_0) w^2``,
+``B = 2 zeta w D(q_0)`` with ``w = 2 pi bandwidth_hz``, so every mode of the arm (not only
+every joint) is a second-order loop of that bandwidth: diagonal gains ``D_ii w^2`` leave modes of
+joints with parallel axes turning against each other (little inertia, the sum of their gains)
+far above the bandwidth, where the 1 kHz loop chatters at 500 Hz. Per-joint gains, when given,
+are diagonal.
+``q_d`` and ``q_0`` start at the first sample's joint positions. In contact the target runs into
+the wall while the arm stops at it; the joints' springs push with the difference.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic_dob.control import saturate
+from haptic_dob.models.base import DeviceModel, Vec
+from haptic_dob.runtime.params import param
+from haptic_dob.validation import nonnegative, positive
+
+
+@dataclass(frozen=True)
+class SlaveImpedance:
+    """The slave's joint impedance and inverse kinematics (group ``slave.``)."""
+
+    bandwidth_hz: float = field(
+        default=8.0,
+        metadata=param(
+            "each joint's loop bandwidth on its own inertia at the start pose", "Hz", 0.1, 200.0
+        ),
+    )
+    damping_ratio: float = field(
+        default=1.0, metadata=param("each joint's damping ratio", "", 0.0, 10.0)
+    )
+    stiffness_n_m_per_rad: list[float] | tuple[float, ...] = field(
+        default_factory=list,
+        metadata=param(
+            "joint stiffness K, one per joint; [] = from bandwidth_hz", "N m/rad", 0.0, 1e6
+        ),
+    )
+    damping_n_m_s_per_rad: list[float] | tuple[float, ...] = field(
+        default_factory=list,
+        metadata=param(
+            "joint damping B, one per joint; [] = from damping_ratio", "N m s/rad", 0.0, 1e5
+        ),
+    )
+    ik_damping_m: float = field(
+        default=0.01, metadata=param("damping lambda of the IK's least squares", "m", 1e-6, 1.0)
+    )
+    posture_gain: float = field(
+        default=0.01,
+        metadata=param(
+            "per-period pull of the redundant joints toward the start posture", "", 0.0, 1.0
+        ),
+    )
+    max_joint_speed_rad_s: float = field(
+        default=2.0,
+        metadata=param("largest speed of the joint target", "rad/s", 1e-3, 100.0),
+    )
+    gravity_compensation: bool = field(
+        default=True, metadata=param("add the model's gravity effort")
+    )
+
+    def __post_init__(self) -> None:
+        positive("bandwidth_hz", self.bandwidth_hz)
+        nonnegative("damping_ratio", self.damping_ratio)
+        for name in ("stiffness_n_m_per_rad", "damping_n_m_s_per_rad"):
+            for i, v in enumerate(getattr(self, name)):
+                nonnegative(f"{name}[{i}]", v)
+        positive("ik_damping_m", self.ik_damping_m)
+        if not 0.0 <= self.posture_gain <= 1.0:
+            raise ValueError(f"posture_gain must be in [0, 1], got {self.posture_gain!r}")
+        positive("max_joint_speed_rad_s", self.max_joint_speed_rad_s)
+
+
+class SlaveController:
+    """Joint impedance tracking a Cartesian point through differential IK (see the module).
+
+    Args:
+        model: the slave's model (its kinematics, inertia at the start pose, gravity, limits).
+        settings: gains and IK settings.
+        dt: the control period (s).
+    """
+
+    def __init__(self, model: DeviceModel, settings: SlaveImpedance, dt: float) -> None:
+        self.model = model
+        self.settings = settings
+        self.dt = positive("dt", dt)
+        n = model.dof
+        for name in ("stiffness_n_m_per_rad", "damping_n_m_s_per_rad"):
+            given = getattr(settings, name)
+            if given and len(given) != n:
+                raise ValueError(f"slave.{name} needs {n} values (one per joint), got {len(given)}")
+        limits = getattr(model, "effort_limits", None)
+        self.limits: list[float] | None = (
+            [float(x) for x in limits]
+            if limits is not None and len(limits) == n and all(x > 0.0 for x in limits)
+            else None
+        )
+        self._eye3 = np.eye(3) * settings.ik_damping_m**2
+        self.q_d: Vec | None = None  # the joint target
+        self.q_0: Vec = np.zeros(n)  # the posture the redundant joints return to
+        self.K = np.zeros((n, n))  # joint stiffness (N m/rad)
+        self.B = np.zeros((n, n))  # joint damping (N m s/rad)
+
+    def start(self, q: Vec) -> None:
+        """Take ``q`` as the joint target, the posture and the pose the gains are set at."""
+        s = self.settings
+        self.q_d = q.copy()
+        self.q_0 = q.copy()
+        inertia = self.model._mass_matrix(q)
+        w = 2.0 * math.pi * s.bandwidth_hz
+        given_k, given_b = s.stiffness_n_m_per_rad, s.damping_n_m_s_per_rad
+        self.K = np.diag(given_k) if given_k else inertia * (w * w)
+        self.B = np.diag(given_b) if given_b else inertia * (2.0 * s.damping_ratio * w)
+
+    def command(self, q: Vec, qd: Vec, target: tuple[float, float, float]) -> list[float]:
+        """Joint efforts (N m or N) for sample ``q``, ``q'`` and the point to track (m)."""
+        if self.q_d is None:
+            self.start(q)
+        q_d = self.q_d
+        assert q_d is not None
+        m, s = self.model, self.settings
+        J = m._jacobian(q_d)
+        e = np.asarray(target) - m._forward_kinematics(q_d)
+        A = J @ J.T + self._eye3
+        Jsharp = J.T @ np.linalg.inv(A)  # (n, 3)
+        dq = Jsharp @ e
+        if s.posture_gain > 0.0:
+            w = s.posture_gain * (self.q_0 - q_d)
+            dq += w - Jsharp @ (J @ w)
+        step = s.max_joint_speed_rad_s * self.dt
+        biggest = float(np.max(np.abs(dq)))
+        if biggest > step:
+            dq *= step / biggest
+        q_d = q_d + dq
+        self.q_d = q_d
+        return self.joint_command(q, qd, q_d)
+
+    def joint_command(self, q: Vec, qd: Vec, q_d: Vec) -> list[float]:
+        """``K (q_d - q) - B q' + G(q)``, saturated (N m or N): the impedance around ``q_d``."""
+        if self.q_d is None:
+            self.start(q)
+        tau = self.K @ (q_d - q) - self.B @ qd
+        if self.settings.gravity_compensation:
+            tau += self.model._gravity(q)
+        out: list[float] = tau.tolist()
+        return out if self.limits is None else saturate(out, self.limits)

@@ -1,0 +1,75 @@
+"""haptic-launch of a teleoperation YAML: each node's parameters, --set, the process plan and the
+options a single loop's launch has that a teleoperation graph refuses."""
+
+from __future__ import annotations
+
+import pytest
+import yaml
+
+from haptic_dob.cli import CliError
+from haptic_dob.launcher.options import LaunchOptions
+from haptic_dob.launcher.teleop import (
+    teleop_command,
+    teleop_params,
+    teleop_plan,
+    write_teleop_params,
+)
+from haptic_dob.teleop.graph import load_teleop_sections
+
+
+@pytest.fixture
+def sections(root):
+    return load_teleop_sections(root / "config" / "teleop_sim.yaml")
+
+
+def test_each_node_gets_its_sections_from_the_general_to_the_specific(sections, root) -> None:
+    params = teleop_params(sections, [])
+    assert list(params)[-2:] == ["master/device_node", "slave/device_node"]  # devices last
+    master, slave = params["master/device_node"], params["slave/device_node"]
+    assert master["model"] == "slide" and slave["model"] == "urdf"  # /<ns>/**
+    assert master["duration_s"] == slave["duration_s"] == 6.0  # /**/device_node
+    assert master["rate_hz"] == 1000.0  # /**
+    assert slave["urdf_path"] == str(root / "config" / "urdf" / "arm7.urdf")  # beside the YAML
+    assert params["master/channel_node"]["role"] == "master"
+    assert params["slave/channel_node"]["channel.round_trip_delay_ms"] == 2.0
+
+
+def test_set_names_one_node_or_both_sides(sections) -> None:
+    params = teleop_params(
+        sections, ["**/device_node:duration_s=1.5", "slave/observer_node:kind=momentum"]
+    )
+    assert params["master/device_node"]["duration_s"] == 1.5
+    assert params["slave/device_node"]["duration_s"] == 1.5
+    assert params["slave/observer_node"]["kind"] == "momentum"
+    assert params["master/observer_node"].get("kind", "dob") == "dob"
+    for bad in ("device_node:seed=1", "master/nosuch:x=1", "slave/device_node:seed"):
+        with pytest.raises(CliError, match="--set needs NS/NODE:PARAM=VALUE"):
+            teleop_params(sections, [bad])
+
+
+def test_composed_by_default_one_process_each_with_processes(sections, tmp_path) -> None:
+    params = teleop_params(sections, [])
+    path = write_teleop_params(params, tmp_path)
+    doc = yaml.safe_load(path.read_text())
+    assert set(doc) == {f"/{n}" for n in params}  # full names: no wildcard to interpret
+    (one,) = teleop_plan(params, path, processes=False)
+    assert one.executable.endswith("container") and one.args[: len(params)] == list(params)
+    each = teleop_plan(params, path, processes=True)
+    assert [s.name for s in each] == list(params)
+    dev = each[-1]
+    assert dev.executable.endswith("device_node")
+    assert dev.args[-4:] == ["-r", "__ns:=/slave", "-r", "__node:=device_node"]
+
+
+@pytest.mark.parametrize(
+    ("option", "flag"),
+    [
+        ({"namespace": "x"}, "--namespace"),
+        ({"only": ("device_node",)}, "--only"),
+        ({"record": "bag"}, "--record"),
+        ({"groups": ("a,b",)}, "--group"),
+    ],
+)
+def test_single_loop_options_are_refused(sections, option, flag) -> None:
+    with pytest.raises(CliError, match=f"{flag}: not for a teleoperation graph"):
+        teleop_command(LaunchOptions(config="teleop_sim", **option), sections)
