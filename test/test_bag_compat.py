@@ -76,18 +76,21 @@ SQLITE_TABLES = {
 
 def recorded(path: Path, storage: str) -> Path:
     """A bag written the way ``recorder_node`` writes one: joint states and poses at 1 kHz
-    stamps, a parameter snapshot on ``/parameter_events``, closed with its counts."""
+    stamps, logged at their stamps (each pose comes after the next joint state, so the log times
+    go back in the file), a parameter snapshot on ``/parameter_events``, closed with its
+    counts."""
     rec = Recording(path, storage, MS)
-    on_js = rec.add_topic("/joint_states", SESSION_TOPICS[JOINT_STATES])
-    on_pose = rec.add_topic("/ee_pose", SESSION_TOPICS[EE_POSE])
+    on_js = rec.add_topic("/joint_states", SESSION_TOPICS[JOINT_STATES], loop=True)
+    on_pose = rec.add_topic("/ee_pose", SESSION_TOPICS[EE_POSE], loop=True)
     rec.add_topic("/parameter_events", PARAMETER_EVENT_TYPE)
     rec.write_snapshot("/controller_node", {"kf": 1.0, "mode": "DOB"}, {"kf": 3, "mode": 4})
     js = wire.joint_state(["slide"], "base_link")
     pose = wire.pose_stamped("base_link")
-    for k in range(N):
-        for msg, on in ((js, on_js), (pose, on_pose)):
-            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(k * MS, 10**9)
-            on(wire.encode(msg))
+    for k in range(N + 1):
+        for msg, on, stamp in ((js, on_js, k), (pose, on_pose, k - 1)):
+            if 0 <= stamp < N:
+                msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp * MS, 10**9)
+                on(wire.encode(msg))
     rec.close()
     return path
 
@@ -135,8 +138,8 @@ def check_mcap(path: Path, meta: dict[str, Any]) -> None:
         (record,) = [m for m in reader.iter_metadata() if m.name == "rosbag2"]
         # decoded as a BagMetadata node itself (no rosbag2_bagfile_information key)
         assert yaml.safe_load(record.metadata["serialized_metadata"]) == meta
-        count = sum(1 for _ in reader.iter_messages())
-    assert count == meta["message_count"]
+        times = [m.log_time for _, _, m in reader.iter_messages(log_time_order=True)]
+    assert len(times) == meta["message_count"] and times == sorted(times)
 
 
 def check_sqlite(path: Path, meta: dict[str, Any]) -> None:
