@@ -264,6 +264,10 @@ def test_a_bag_as_ros2_bag_record_writes_it_goes_through_every_analysis(
     assert [s["observer_gain"] for s in got] == [41.6, 30.0]
     assert got[1]["start_s"] == CHANGE_AT / 1000.0
     assert got == want
+    joints = ["--motion-topic", "joint_states", "--joint", "slide"]
+    assert cli_json(analyze, [str(theirs), *joints], capsys) == cli_json(
+        analyze, [str(ours), *joints], capsys
+    )
     assert cli_json(identify, [str(theirs)], capsys) == cli_json(identify, [str(ours)], capsys)
 
 
