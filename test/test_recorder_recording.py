@@ -137,3 +137,38 @@ def test_receive_log_time_is_the_wall_clock(tmp_path: Path) -> None:
     assert len(times) == 2 and all(before <= t <= after for t in times)
     with pytest.raises(ValueError, match="log_time must be one of session, receive"):
         Recording(tmp_path / "other", "mcap", MS, log_time="wall")
+
+
+def test_the_analysis_splits_a_session_logged_bag_where_the_changes_took_effect(
+    tmp_path: Path,
+) -> None:
+    """Log times on the session's time keep the analysis right: a change a loop node stamped
+    with its sample splits there however late it came; one stamped with a wall clock (a node
+    of another graph) splits at the newest sample received before it."""
+    from bagdata import msd_record, session_params
+    from haptic_dob.bag.analyze import analyze_bag
+    from haptic_dob.bag.write import vector_template
+
+    x, force, v = msd_record(12.0, 1000.0, 0.5, 2.0, 800.0)
+    rec = Recording(tmp_path / "bag", "mcap", MS)
+    on = {
+        t: rec.add_topic(f"/{t}", SESSION_TOPICS[t], loop=True)
+        for t in ("ee_pose", "ee_twist", "wrench_measured")
+    }
+    on_events = rec.add_topic("/parameter_events", PARAMETER_EVENT_TYPE)
+    for node, values in session_params("OL", 0.0, 800.0).items():
+        rec.write_snapshot(f"/{node}", values, {})
+    tpl = {t: vector_template(SESSION_TOPICS[t]) for t in on}
+    wall = 1_767_225_600 * 10**9
+    for k in range(x.size):
+        for t, value in (("ee_pose", x[k]), ("ee_twist", v[k]), ("wrench_measured", force[k])):
+            on[t](tpl[t].fill(k * MS, (float(value), 0.0, 0.0)))
+        if k == 4010:  # stamped with sample 4000, received 10 samples later
+            on_events(parameter_event("/controller_node", {"kf": 1.0}, 4000 * MS, False))
+        if k == 8000:  # a wall-clock stamp: the newest sample received decides
+            on_events(parameter_event("/environment_node", {"damping_n_s_per_m": 1.0}, wall, False))
+    rec.close()
+    segs = analyze_bag(tmp_path / "bag").segments
+    assert [s.start_s for s in segs] == [0.0, 4.0, 8.0]
+    assert [s.kf for s in segs] == [0.0, 1.0, 1.0]
+    assert [s.damping_n_s_per_m for s in segs] == [0.0, 0.0, 1.0]
