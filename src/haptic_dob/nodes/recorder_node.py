@@ -5,19 +5,16 @@
   publishers' last 2000 samples), the parameter-events profile for ``/parameter_events``,
   reliable volatile for other topics. Bag time: the session's (``log_time``, as ``ros2 bag
   record --use-sim-time``; ``/clock`` is read where no loop topic is recorded) or receive time.
-- Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``;
-  a node silent for ``snapshot_timeout_s`` is warned about and still asked) as a
-  ``rcl_interfaces/msg/ParameterEvent`` with all parameters in ``new_parameters``, on
-  ``/parameter_events`` beside the live events, so the bag says which stiffness, mode and gains
-  were active at every moment. Nodes that start later are snapshot when they appear.
-- Publishes ``recorder/progress`` (``std_msgs/Header``: the stamp, this recorder's name in
-  ``frame_id``; reliable, transient local) at ``progress_rate_hz``: the newest stamp written,
-  minimum over the stamped topics that are flowing. A lockstep device
-  holds the loop while that lags, so a recorded lockstep run loses nothing. The report is held
-  where a node appeared until its parameters came (at most ``snapshot_timeout_s``), so a short
-  lockstep run cannot end before the bag knows the session's parameters. Before the first loop
-  sample it reports ``PROGRESS_NOT_MATCHED_NS`` while a reader has not matched its writers
-  (``haptic_dob.recorder.matching``): the device sends sample 0 only after that.
+- Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``,
+  when it appears; one silent for ``snapshot_timeout_s`` is warned about and still asked) as a
+  ``ParameterEvent`` with all parameters in ``new_parameters`` on ``/parameter_events``, so the
+  bag says which stiffness, mode and gains were active at every moment.
+- Publishes ``recorder/progress`` (``std_msgs/Header``: the newest stamp written, minimum over
+  the stamped topics flowing; its name in ``frame_id``) at ``progress_rate_hz``: a lockstep
+  device holds the loop while that lags, so a recorded lockstep run loses nothing. The report is
+  held where a node appeared until its parameters came (at most ``snapshot_timeout_s``). Before
+  the first loop sample it is ``PROGRESS_NOT_MATCHED_NS`` while a reader has not matched its
+  writers (``haptic_dob.recorder.matching``): the device sends sample 0 only after that.
 - On SIGINT/SIGTERM (or after ``duration_s``) it takes what is still queued (at most
   ``drain_timeout_s``, until nothing arrives for 0.1 s), then closes the bag so it is readable,
   and reports per topic what it received, wrote and which stamps are missing (gaps).
