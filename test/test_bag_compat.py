@@ -7,6 +7,10 @@ file (the ``ros2`` profile, the statistics record, the ``rosbag2`` metadata reco
 ``offered_qos_profiles``), read with an independent MCAP reader (``mcap``, Foxglove's, checking
 every CRC), and the tables ``rosbag2_storage_sqlite3/src/.../sqlite_storage.cpp`` creates (schema
 version 4). A killed recording's recovered bag passes the same checks.
+
+The other way: bags as ``ros2 bag record`` writes them (``ros2bag``: MCAP uncompressed and with
+zstd chunks, sqlite3; ``ros2msg`` schemas, receive times, the type hashes) go through
+``haptic-analyze`` and ``haptic-identify`` and give what our recording of the same session gives.
 """
 
 from __future__ import annotations
@@ -76,18 +80,21 @@ SQLITE_TABLES = {
 
 def recorded(path: Path, storage: str) -> Path:
     """A bag written the way ``recorder_node`` writes one: joint states and poses at 1 kHz
-    stamps, a parameter snapshot on ``/parameter_events``, closed with its counts."""
+    stamps, logged at their stamps (each pose comes after the next joint state, so the log times
+    go back in the file), a parameter snapshot on ``/parameter_events``, closed with its
+    counts."""
     rec = Recording(path, storage, MS)
-    on_js = rec.add_topic("/joint_states", SESSION_TOPICS[JOINT_STATES])
-    on_pose = rec.add_topic("/ee_pose", SESSION_TOPICS[EE_POSE])
+    on_js = rec.add_topic("/joint_states", SESSION_TOPICS[JOINT_STATES], loop=True)
+    on_pose = rec.add_topic("/ee_pose", SESSION_TOPICS[EE_POSE], loop=True)
     rec.add_topic("/parameter_events", PARAMETER_EVENT_TYPE)
     rec.write_snapshot("/controller_node", {"kf": 1.0, "mode": "DOB"}, {"kf": 3, "mode": 4})
     js = wire.joint_state(["slide"], "base_link")
     pose = wire.pose_stamped("base_link")
-    for k in range(N):
-        for msg, on in ((js, on_js), (pose, on_pose)):
-            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(k * MS, 10**9)
-            on(wire.encode(msg))
+    for k in range(N + 1):
+        for msg, on, stamp in ((js, on_js, k), (pose, on_pose, k - 1)):
+            if 0 <= stamp < N:
+                msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp * MS, 10**9)
+                on(wire.encode(msg))
     rec.close()
     return path
 
@@ -117,8 +124,9 @@ def check_metadata(doc: dict[str, Any], storage: str) -> dict[str, Any]:
     return meta
 
 
-def check_mcap(path: Path, meta: dict[str, Any]) -> None:
-    """What rosbag2's MCAP plugin reads, through an independent reader that checks CRCs."""
+def check_mcap(path: Path, meta: dict[str, Any], in_order: bool = True) -> None:
+    """What rosbag2's MCAP plugin reads, through an independent reader that checks CRCs;
+    ``in_order``: also read every message in log-time order (slow for a large bag)."""
     from mcap.reader import make_reader
 
     with path.open("rb") as fh:
@@ -135,8 +143,9 @@ def check_mcap(path: Path, meta: dict[str, Any]) -> None:
         (record,) = [m for m in reader.iter_metadata() if m.name == "rosbag2"]
         # decoded as a BagMetadata node itself (no rosbag2_bagfile_information key)
         assert yaml.safe_load(record.metadata["serialized_metadata"]) == meta
-        count = sum(1 for _ in reader.iter_messages())
-    assert count == meta["message_count"]
+        times = [m.log_time for _, _, m in reader.iter_messages(log_time_order=in_order)]
+    assert len(times) == meta["message_count"]
+    assert times == sorted(times) or not in_order
 
 
 def check_sqlite(path: Path, meta: dict[str, Any]) -> None:
@@ -158,11 +167,11 @@ def check_sqlite(path: Path, meta: dict[str, Any]) -> None:
         db.close()
 
 
-def check_bag(bag: Path, storage: str) -> None:
+def check_bag(bag: Path, storage: str, in_order: bool = True) -> None:
     meta = check_metadata(yaml.safe_load((bag / "metadata.yaml").read_text()), storage)
     (name,) = meta["relative_file_paths"]
     if storage == "mcap":
-        check_mcap(bag / name, meta)
+        check_mcap(bag / name, meta, in_order)
     else:
         check_sqlite(bag / name, meta)
 
@@ -181,83 +190,101 @@ def test_a_recovered_bag_is_what_rosbag2_jazzy_reads(tmp_path: Path, storage: st
     check_bag(got.out, storage)
 
 
-def as_ros2_bag_records_it(src: Path, dst: Path, storage: str) -> None:
-    """``src`` rewritten as ``ros2 bag record`` of the running graph holds it: every topic with
-    the publishers' offered QoS, no parameter snapshots (it records only live events), no custom
-    data of ours."""
-    from rosbags.interfaces import (
-        Qos,
-        QosDurability,
-        QosHistory,
-        QosLiveliness,
-        QosReliability,
-        QosTime,
-    )
-    from rosbags.rosbag2 import Reader
-
-    from haptic_dob.bag.write import open_writer
-    from haptic_msgs_py.ros.qos import LOOP_HISTORY
-
-    never = QosTime(0x7FFFFFFF, 0xFFFFFFFF)
-    offered = Qos(
-        QosHistory.KEEP_LAST,
-        LOOP_HISTORY,
-        QosReliability.RELIABLE,
-        QosDurability.VOLATILE,
-        never,
-        never,
-        QosLiveliness.AUTOMATIC,
-        never,
-        False,
-    )
-    writer = open_writer(dst, storage)
-    with Reader(src) as reader:
-        conns = [c for c in reader.connections if c.topic != "/parameter_events"]
-        added = {
-            c.id: writer.add_connection(
-                c.topic, c.msgtype, typestore=wire.TYPESTORE, offered_qos_profiles=[offered]
-            )
-            for c in conns
-        }
-        for conn, t, data in reader.messages(conns):
-            writer.write(added[conn.id], t, data)
-    writer.close()
+ROS2_BAGS = [("mcap", "none"), ("mcap", "zstd_fast"), ("sqlite3", "none")]
+CHANGE_AT = 7000  # a live ros2 param set of the observer's gain, at this sample
+ID_KEYS = ("bag",)  # what differs between two bags of one session: their path
 
 
-@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
-def test_a_bag_as_ros2_bag_records_it_goes_through_the_analyses(
-    tmp_path: Path, storage: str, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """No parameter snapshots: the wall stiffness comes from ``--stiffness``; the figures equal
-    those of our own recording of the same session, and the model is identified from it."""
+def session_bags(
+    tmp_path: Path, storage: str, preset: str, declarations: bool = True
+) -> tuple[Path, Path]:
+    """(ours, theirs): one 12 s OL session with a live change of the observer's gain, written
+    by our writer (``write_session_bag``: parameter snapshots, log times from the epoch) and as
+    ``ros2 bag record -a`` writes it (``ros2bag``: receive times, the nodes' declarations
+    if it was up before them, the change stamped with its sample, /clock, /rosout,
+    /diagnostics)."""
     from bagdata import session_params
-    from haptic_dob.bag.analyze import AnalysisSettings, analyze_bag
-    from haptic_dob.bag.write import write_session_bag
+    from haptic_dob.bag.write import ParamChange, write_session_bag
     from haptic_dob.control import ControlMode, ImpedanceLaw
-    from haptic_dob.identify_cli import main as identify
     from haptic_sim.session import SessionConfig, run_session
+    from ros2bag import write_ros2_bag
+    from ros2bag_session import session_as_recorded
 
     cfg = SessionConfig.from_yaml(Path(__file__).parents[1] / "config" / "slide_sim.yaml")
     res = run_session(
         cfg.replace(law=ImpedanceLaw(ControlMode.OL, 0.0, 4.0), loop__duration_s=12.0)
     )
+    params = {"device_node": {"clock_mode": "realtime", "seed": 0}, **session_params("OL")}
+    changes = [ParamChange(CHANGE_AT, "observer_node", {"gain": 30.0})]
     ours = tmp_path / "ours"
     write_session_bag(
-        ours,
-        res.q,
-        res.force_measured,
-        1000.0,
-        session_params("OL", 0.0, 800.0),
-        velocity=res.qd,
-        storage=storage,
-        all_topics=True,
+        ours, res.q, res.force_measured, 1000.0, params, changes, res.qd, storage, all_topics=True
     )
-    theirs = tmp_path / "theirs"
-    as_ros2_bag_records_it(ours, theirs, storage)
-    check_metadata(yaml.safe_load((theirs / "metadata.yaml").read_text()), storage)
-    (want,) = analyze_bag(ours).segments
-    (got,) = analyze_bag(theirs, settings=AnalysisSettings(stiffness_n_per_m=800.0)).segments
-    for key in ("bandwidth_hz", "impedance_error_pct", "coherence_in_band", "max_active_energy_j"):
-        assert got.as_dict()[key] == want.as_dict()[key], key
-    assert identify([str(theirs), "--json"]) == 0
-    assert '"mass_kg"' in capsys.readouterr().out
+    topics, messages = session_as_recorded(
+        res.q, res.force_measured, res.qd, 1000.0, params, changes, declarations
+    )
+    theirs = write_ros2_bag(tmp_path / "theirs", storage, topics, messages, preset)
+    return ours, theirs
+
+
+def cli_json(main: Any, argv: list[str], capsys: pytest.CaptureFixture[str]) -> Any:
+    """A command's ``--json`` output, parsed, with the bag's path left out."""
+    import json
+
+    assert main([*argv, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for item in out if isinstance(out, list) else [out]:
+        for key in ID_KEYS:
+            item.pop(key, None)
+    return out
+
+
+@pytest.mark.parametrize(("storage", "preset"), ROS2_BAGS, ids=["mcap", "mcap-zstd", "sqlite3"])
+def test_a_bag_as_ros2_bag_record_writes_it_goes_through_every_analysis(
+    tmp_path: Path, storage: str, preset: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``ros2 bag record -a`` started before the session (it has the nodes' declarations):
+    haptic-analyze finds the same segments and figures as in our recording of the same session
+    (the live change split at its stamp, whatever its receive time), haptic-identify the same
+    model."""
+    from haptic_dob.bag.cli import main as analyze
+    from haptic_dob.identify_cli import main as identify
+
+    ours, theirs = session_bags(tmp_path, storage, preset)
+    check_bag(theirs, storage, in_order=False)  # the fixture holds what rosbag2 Jazzy reads
+    if storage == "mcap":
+        from mcap.reader import make_reader
+
+        with next(theirs.glob("*.mcap")).open("rb") as fh:
+            summary = make_reader(fh).get_summary()
+        assert summary is not None
+        chunks = {c.compression for c in summary.chunk_indexes}
+        assert chunks == ({"zstd"} if preset == "zstd_fast" else {""})
+    want = cli_json(analyze, [str(ours)], capsys)
+    got = cli_json(analyze, [str(theirs)], capsys)
+    assert [s["segment"] for s in got] == [0, 1]
+    assert [s["observer_gain"] for s in got] == [41.6, 30.0]
+    assert got[1]["start_s"] == CHANGE_AT / 1000.0
+    assert got == want
+    joints = ["--motion-topic", "joint_states", "--joint", "slide"]
+    assert cli_json(analyze, [str(theirs), *joints], capsys) == cli_json(
+        analyze, [str(ours), *joints], capsys
+    )
+    assert cli_json(identify, [str(theirs)], capsys) == cli_json(identify, [str(ours)], capsys)
+
+
+def test_a_bag_of_ros2_bag_record_started_late_needs_the_stiffness(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Started after the nodes: no declarations, so the wall stiffness comes from
+    ``--stiffness``; the live change still splits the session at its stamp."""
+    from haptic_dob.bag.cli import main as analyze
+
+    ours, theirs = session_bags(tmp_path, "mcap", "zstd_fast", declarations=False)
+    assert analyze([str(theirs)]) == 2
+    assert "no wall stiffness recorded (pass --stiffness)" in capsys.readouterr().err
+    want = cli_json(analyze, [str(ours)], capsys)
+    got = cli_json(analyze, [str(theirs), "--stiffness", "800"], capsys)
+    assert [s["observer_gain"] for s in got] == [None, 30.0]
+    for key in ("bandwidth_hz", "impedance_error_pct", "coherence_in_band", "start_s"):
+        assert [s[key] for s in got] == [s[key] for s in want], key

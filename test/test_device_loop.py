@@ -319,3 +319,19 @@ def test_settings_are_checked_against_the_actuator_and_taken_at_once() -> None:
         loop.settings_for(values(effort_limits=[5.0]))
     loop.configure(loop.settings_for(values(effort_limits=[1.0], command_timeout_s=0.01)))
     assert loop.guard.limits == (1.0,) and loop.settings.command_timeout_s == 0.01
+
+
+def test_wait_for_names_a_node_here_or_anywhere_by_its_full_name() -> None:
+    """A plain ``wait_for`` name is a node of the device's namespace; ``/rosbag2_recorder``
+    (``ros2 bag record``'s node, in the root namespace) waits for a recorder of a namespaced
+    session."""
+    from haptic_sim.device_settings import missing_nodes
+
+    graph = [("controller_node", "/slide1"), ("rosbag2_recorder", "/"), ("probe", "/lab/a")]
+    wait_for = ["controller_node", "/rosbag2_recorder", "/lab/a/probe"]
+    assert missing_nodes(wait_for, graph, "/slide1") == []
+    assert missing_nodes(wait_for, graph, "/") == ["controller_node"]
+    assert missing_nodes(["rosbag2_recorder", "/slide1/controller_node"], graph, "/slide1") == [
+        "rosbag2_recorder"
+    ]
+    assert missing_nodes(["/rosbag2_recorder"], graph[:1], "/slide1") == ["/rosbag2_recorder"]

@@ -17,7 +17,7 @@ from haptic_dob.control import ControlMode, ImpedanceLaw
 from haptic_msgs_py.stamps import NS_PER_S
 from haptic_msgs_py.topics import RECORDER_PROGRESS
 from haptic_sim.session import SessionConfig, run_session
-from recorded import assert_received_written_in_bag, bag_stamps
+from recorded import assert_logged_on_session_time, assert_received_written_in_bag, bag_stamps
 from rosgraph import Collector, Process, isolated_env, launch, resent, switch
 from waits import wait_until
 
@@ -96,6 +96,7 @@ def test_recorded_lockstep_session_loses_nothing_and_equals_the_batch_run(root, 
             assert np.array_equal(unique[:n], np.arange(n) * MS), (bag, topic)
         report = assert_received_written_in_bag(bag)
         assert report["parameter_snapshots"] >= 4  # device, environment, observer, controller
+        assert_logged_on_session_time(bag)
         assert all(c["gaps"] == 0 for c in report["topics"].values())
         data = read_bag(bag)
         assert np.array_equal(data.motion.values[:n], res.q)
@@ -197,6 +198,7 @@ def test_signals_leave_readable_bags_and_a_live_switch_splits_the_session(root, 
     for bag, proc, storage in ((b, rec_b, "sqlite3"), (c, rec_c, "mcap")):
         assert f"bag: {bag} ({storage})" in proc.output()
         assert_received_written_in_bag(bag)
+        assert_logged_on_session_time(bag)
         stamps = bag_stamps(bag)
         assert stamps["/ee_pose"].size > 10_000
         assert_device_topics(stamps, resends, None)  # from sample 0 on, none missing

@@ -10,10 +10,12 @@ from pathlib import Path
 
 import pytest
 import rclpy
+from builtin_interfaces.msg import Time
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
 from conftest import tool
+from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
 from haptic_dob.bag.reader import open_bag
 from haptic_dob.nodes.recorder_node import RecorderNode
 from haptic_msgs_py import wire
@@ -81,11 +83,19 @@ def test_records_counts_snapshots_and_reports_progress(context, tmp_path, storag
             "/effort_command": 199,
             "/parameter_events": ev_c.written,
         }
+        logged = [(c.topic, t, d) for c, t, d in reader.messages()]
         events = [
             reader.deserialize(d, c.msgtype)
             for c, _, d in reader.messages()
             if c.topic == "/parameter_events"
         ]
+    # bag time is the session's: a loop message's own stamp, the live change (stamped with the
+    # node's wall clock) at the newest stamp received before it
+    pose_t = [(t, header_stamp_ns(d)) for topic, t, d in logged if topic == "/ee_pose"]
+    assert all(t == stamp for t, stamp in pose_t) and len(pose_t) == 199
+    cmd_t = [(t, command_label_stamp_ns(d)) for topic, t, d in logged if topic == "/effort_command"]
+    assert all(t == stamp for t, stamp in cmd_t) and len(cmd_t) == 199
+    assert [t for topic, t, _ in logged if topic == "/parameter_events"][-1] == stamps[-1]
     env = [e for e in events if e.node == "/environment_node"]
     snaps = [
         e
@@ -103,6 +113,43 @@ def test_records_counts_snapshots_and_reports_progress(context, tmp_path, storag
     report = counts.to_json()
     assert report["topics"]["/ee_pose"]["written"] == 199
     assert json.loads(json.dumps(report)) == report
+
+
+def test_without_loop_topics_the_session_time_comes_from_clock(context, tmp_path) -> None:
+    """Recording only ``/parameter_events``: the recorder reads ``/clock`` (the device publishes
+    it while someone reads it) and logs the events at its newest time."""
+    from rosgraph_msgs.msg import Clock
+
+    out = tmp_path / "bag"
+    rec = RecorderNode(
+        context=context,
+        parameter_overrides=[
+            Parameter("output", value=str(out)),
+            Parameter("topics", value=["/parameter_events"]),
+        ],
+    )
+    src = rclpy.create_node("environment_node", context=context)
+    src.declare_parameter("stiffness_n_per_m", 800.0)
+    clock = src.create_publisher(Clock, "/clock", qos.CLOCK)
+    ex = SingleThreadedExecutor(context=context)
+    ex.add_node(rec)
+    ex.add_node(src)
+    try:
+        assert wait_until(lambda: clock.get_subscription_count() == 1, 10.0, step=spin(ex))
+        clock.publish(Clock(clock=Time(sec=7, nanosec=5)))
+        assert wait_until(lambda: rec.recording.session_ns > 0, 10.0, step=spin(ex))
+        count = rec.recording.counts.topics[0]
+        live = count.received
+        src.set_parameters([Parameter("stiffness_n_per_m", value=1600.0)])
+        assert wait_until(lambda: count.received == live + 1, 10.0, step=spin(ex))
+    finally:
+        ex.shutdown()
+        rec.close()
+        src.destroy_node()
+        rec.destroy_node()
+    with open_bag(out) as reader:
+        times = [t for _, t, _ in reader.messages()]
+    assert times[-1] == 7_000_000_005
 
 
 def test_progress_is_held_while_a_node_has_not_given_its_parameters(context, tmp_path) -> None:

@@ -8,7 +8,13 @@ from pathlib import Path
 import pytest
 
 from haptic_dob.bag.write import open_writer
-from haptic_dob.recorder.settings import DEFAULT_TOPICS, STORAGES, new_bag_path, recorder_specs
+from haptic_dob.recorder.settings import (
+    DEFAULT_TOPICS,
+    LOG_TIMES,
+    STORAGES,
+    new_bag_path,
+    recorder_specs,
+)
 
 
 def test_parameters() -> None:
@@ -16,6 +22,7 @@ def test_parameters() -> None:
     assert list(specs) == [
         "output",
         "storage",
+        "log_time",
         "topics",
         "duration_s",
         "rate_hz",
@@ -24,6 +31,7 @@ def test_parameters() -> None:
         "drain_timeout_s",
     ]
     assert specs["storage"].choices == STORAGES
+    assert specs["log_time"].choices == LOG_TIMES and specs["log_time"].default == "session"
     assert specs["topics"].default == DEFAULT_TOPICS and specs["topics"].length is None
     assert [n for n, s in specs.items() if not s.read_only] == ["rate_hz"]
 

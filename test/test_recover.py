@@ -38,13 +38,22 @@ def sample(k: int) -> bytes:
     return wire.encode(msg)
 
 
-def killed_copy(bag: Path, storage: str, durable_at: tuple[int, ...], n: int, to: Path) -> None:
+def killed_copy(
+    bag: Path, storage: str, durable_at: tuple[int, ...], n: int, to: Path, late: bool = False
+) -> None:
     """Write ``n`` samples to a new bag, durable after each sample count in ``durable_at``, then
-    copy the files as they are on disk without closing the writer: what a kill -9 leaves."""
+    copy the files as they are on disk without closing the writer: what a kill -9 leaves.
+
+    ``late``: each sample also on ``/late``, written after the next sample of ``/joint_states``
+    and logged at its own stamp, as the recorder logs a loop message that came late: the log
+    times go back in the file."""
     writer = open_writer(bag, storage)
     conn = writer.add_connection("/joint_states", JS_TYPE, typestore=TYPESTORE)
+    other = writer.add_connection("/late", JS_TYPE, typestore=TYPESTORE) if late else None
     for k in range(n):
         writer.write(conn, k * PERIOD_NS, sample(k))
+        if other is not None and k > 0:
+            writer.write(other, (k - 1) * PERIOD_NS, sample(k - 1))
         if k + 1 in durable_at:
             make_durable(writer)
     to.mkdir()
@@ -54,10 +63,10 @@ def killed_copy(bag: Path, storage: str, durable_at: tuple[int, ...], n: int, to
     writer.close()
 
 
-def stamps_of(bag: Path) -> list[int]:
+def stamps_of(bag: Path, topic: str = "/joint_states") -> list[int]:
     """The joint-state stamps (ns) of a closed bag, through the analysis' own reader."""
     with open_bag(bag) as reader:
-        conns = [c for c in reader.connections if c.topic == "/joint_states"]
+        conns = [c for c in reader.connections if c.topic == topic]
         return [
             stamp_ns(TYPESTORE.deserialize_cdr(d, JS_TYPE)) for _, _, d in reader.messages(conns)
         ]
@@ -73,6 +82,16 @@ def test_everything_made_durable_is_recovered(tmp_path: Path, storage: str) -> N
     assert got.out == tmp_path / "killed_recovered"
     assert (got.messages, got.topics, got.storage) == (2000, 1, storage)
     assert stamps_of(got.out) == [k * PERIOD_NS for k in range(2000)]
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_log_times_that_go_back_are_recovered(tmp_path: Path, storage: str) -> None:
+    killed = tmp_path / "killed"
+    killed_copy(tmp_path / "live", storage, (1000, 2000), 2500, killed, late=True)
+    got = recover(killed)
+    assert got.messages == 2000 + 1999
+    assert stamps_of(got.out) == [k * PERIOD_NS for k in range(2000)]
+    assert stamps_of(got.out, "/late") == [k * PERIOD_NS for k in range(1999)]
 
 
 def test_a_record_cut_in_the_middle_is_left_out(tmp_path: Path) -> None:

@@ -89,11 +89,15 @@ def _mapped(pid: int, library: str) -> bool:
 PHASES = {"importing": "_multiarray_umath", "rclpy_loaded": "_rclpy_pybind11"}
 
 
+#: what each executable is started with (the container: the loop's four nodes, as ros2 launch's)
+START_ARGS = {"container": ["device_node", "environment_node", "observer_node", "controller_node"]}
+
+
 @pytest.mark.parametrize("phase", list(PHASES))
 @pytest.mark.parametrize(
     ("package", "name"),
-    [("haptic_sim", "device_node"), ("haptic_dob", "controller_node")],
-    ids=["device_node", "controller_node"],
+    [("haptic_sim", "device_node"), ("haptic_dob", "controller_node"), ("haptic_dob", "container")],
+    ids=["device_node", "controller_node", "container"],
 )
 def test_ctrl_c_during_start_up_ends_quietly(package: str, name: str, phase: str) -> None:
     """``ros2 launch`` or a terminal sends SIGINT while the node still imports numpy, pinocchio
@@ -103,7 +107,10 @@ def test_ctrl_c_during_start_up_ends_quietly(package: str, name: str, phase: str
     to handle and may print its traceback; the shim keeps the wheels' re-exec out of the way.)"""
     exe = Path(get_package_prefix(package)) / "lib" / package / name
     proc = subprocess.Popen(
-        [str(exe)], env=isolated_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT
+        [str(exe), *START_ARGS.get(name, [])],
+        env=isolated_env(),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
     )
     try:
         # a hang guard: the phase comes within the start-up

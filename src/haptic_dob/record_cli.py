@@ -17,7 +17,7 @@ import math
 import sys
 
 from haptic_dob.cli import ArgumentParser, CliError, run
-from haptic_dob.recorder.settings import STORAGES, new_bag_path
+from haptic_dob.recorder.settings import LOG_TIMES, STORAGES, new_bag_path
 
 
 def command(
@@ -28,6 +28,7 @@ def command(
     topics: list[str] | None,
     node_name: str,
     rate_hz: float,
+    log_time: str = "session",
 ) -> int:
     """Check the arguments, record, print the counts; ``CliError``/``ValueError`` on bad input."""
     path = new_bag_path(output or "")
@@ -39,7 +40,9 @@ def command(
         namespace = "/" + namespace
     from haptic_dob.nodes.recorder_run import record
 
-    code, node = record(str(path), storage, namespace, duration, topics, node_name, rate_hz)
+    code, node = record(
+        str(path), storage, namespace, duration, topics, node_name, rate_hz, log_time
+    )
     if node is not None:
         rec = node.recording
         print(rec.counts.table(rec.path, rec.storage))
@@ -77,6 +80,13 @@ def main(argv: list[str] | None = None) -> int:
         help="loop rate, to count missing stamps (default 1000)",
     )
     p.add_argument(
+        "--log-time",
+        choices=LOG_TIMES,
+        default="session",
+        help="bag time of each message: the session's (its own stamp, or the newest one; as "
+        "ros2 bag record --use-sim-time; default) or the wall-clock receive time",
+    )
+    p.add_argument(
         "--recover",
         metavar="BAG",
         help="instead of recording: write the complete part of a recording that was killed "
@@ -86,7 +96,9 @@ def main(argv: list[str] | None = None) -> int:
     if a.recover is not None:
         return run(lambda: recover_command(a.recover, a.output))
     return run(
-        lambda: command(a.output, a.storage, a.namespace, a.duration, a.topics, a.node_name, a.rate)
+        lambda: command(
+            a.output, a.storage, a.namespace, a.duration, a.topics, a.node_name, a.rate, a.log_time
+        )
     )
 
 

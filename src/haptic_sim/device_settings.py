@@ -4,12 +4,12 @@
 ``safety_specs`` (the watchdog's timeout, the command guard's limits), the loop, process, model,
 clock and simulation rows, then ``schedule_specs`` (lockstep re-sends, the start-up gate,
 recorder back-pressure, the statistics file). ``DeviceLoopSettings`` is what the loop reads of
-them at run time.
+them at run time; ``missing_nodes`` which of ``wait_for`` the graph lacks.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -82,8 +82,9 @@ def schedule_specs() -> list[ParamSpec]:
         ParamSpec(
             "wait_for",
             list(DEFAULT_WAIT_FOR),
-            "nodes (in this namespace) that must be up before sample 0, in both clock modes "
-            "(realtime with []: tick at once, the watchdog holds zero effort until commands come)",
+            "nodes that must be up before sample 0, in both clock modes: a name in this "
+            "namespace, or fully qualified (/rosbag2_recorder); realtime with []: tick at once, "
+            "the watchdog holds zero effort until commands come",
             read_only=True,
         ),
         ParamSpec(
@@ -135,3 +136,17 @@ class DeviceLoopSettings:
             values["start_delay_s"],
             tuple(values["wait_for"]),
         )
+
+
+def missing_nodes(
+    wait_for: Iterable[str], graph: Iterable[tuple[str, str]], namespace: str
+) -> list[str]:
+    """The ``wait_for`` entries that are not up in ``graph`` ((name, namespace) of each node): a
+    plain name is a node of ``namespace``, one starting with ``/`` a fully qualified name (a
+    recorder elsewhere, such as ``ros2 bag record``'s ``/rosbag2_recorder``)."""
+    here, everywhere = set(), set()
+    for name, space in graph:
+        everywhere.add(f"{space.rstrip('/')}/{name}")
+        if space == namespace:
+            here.add(name)
+    return [w for w in wait_for if w not in (everywhere if w.startswith("/") else here)]

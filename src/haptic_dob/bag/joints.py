@@ -2,7 +2,7 @@
 
 Any rosbag2 bag (MCAP or sqlite3, ours or ``ros2 bag record``'s): a bag holding nothing but
 ``/joint_states`` as a driver publishes it (name, position, velocity, effort) is enough for
-``haptic-identify``. Stamps come from the messages' headers, or from the receive times when no
+``haptic-identify``. Stamps come from the messages' headers, or from the bag (log) times when no
 header is stamped (a driver that leaves them zero); a lockstep run's first sample is stamped 0
 legitimately.
 """
@@ -85,7 +85,7 @@ def read_joints(
         else:
             why = f"names {', '.join(wanted)} in no one message"
         raise BagError(f"{shown}: {name} {why}; joints: {', '.join(seen)}")
-    if not any(stamps):  # no header stamped: the receive times
+    if not any(stamps):  # no header stamped: the bag (log) times
         stamps = received
     order = np.argsort(np.asarray(stamps), kind="stable")
     return JointStates(

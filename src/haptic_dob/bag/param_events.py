@@ -12,7 +12,7 @@ PARAMETER_EVENT = "rcl_interfaces/msg/ParameterEvent"
 class ParamEvent:
     """One ``rcl_interfaces/msg/ParameterEvent`` as recorded."""
 
-    time_ns: int  # bag (receive) time
+    time_ns: int  # bag (log) time
     node: str  # fully qualified node name, e.g. /controller_node
     values: dict[str, Any]  # new and changed parameters
     deleted: tuple[str, ...]
@@ -45,7 +45,7 @@ def _param_value(v: Any) -> Any:
 
 
 def param_event(msg: Any, time_ns: int) -> ParamEvent:
-    """A ``ParamEvent`` of a decoded ParameterEvent message received at ``time_ns``."""
+    """A ``ParamEvent`` of a decoded ParameterEvent message logged at ``time_ns``."""
     values = {p.name: _param_value(p.value) for p in msg.new_parameters}
     values.update({p.name: _param_value(p.value) for p in msg.changed_parameters})
     deleted = tuple(p.name for p in msg.deleted_parameters)

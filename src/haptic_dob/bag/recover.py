@@ -144,6 +144,15 @@ def _reader(copy: Path, storage: str) -> Any:
     return Sqlite3Reader(copy)
 
 
+def _in_file_order(reader: Any, conns: list[Any], storage: str) -> Any:
+    """The messages as written. An MCAP copy without its summary is read by scanning, which
+    rosbags' ``messages`` refuses when log times go back (a recorder logging loop messages at
+    their own stamps writes them in the order they came); the new bag is indexed again."""
+    if storage == "mcap":
+        return reader.messages_scan(conns)
+    return reader.messages(conns)
+
+
 def _typestore(conns: list[Any], path: Path) -> Any:
     """Jazzy's typestore, with any type of ``conns`` it lacks read from the bag's definition."""
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
@@ -200,11 +209,11 @@ def recover(bag: str | Path, out: str | Path | None = None) -> Recovery:
                 for c in conns
             }
             count, first, last = 0, None, None
-            for conn, stamp, data in reader.messages(conns):
+            for conn, stamp, data in _in_file_order(reader, conns, storage):
                 writer.write(added[conn.id], stamp, data)
                 count += 1
-                first = stamp if first is None else first
-                last = stamp
+                first = stamp if first is None else min(first, stamp)
+                last = stamp if last is None else max(last, stamp)
             span = (last - first) * 1e-9 if first is not None and last is not None else 0.0
             got = Recovery(bag, target, storage, count, len(conns), span, dropped)
             writer.set_custom_data(RECOVERED_KEY, json.dumps(got.as_json()))

@@ -29,7 +29,7 @@ class Record:
     x: np.ndarray
     force: np.ndarray
     velocity: np.ndarray
-    recv_ns: np.ndarray  # bag (receive) time of each grid point, non-decreasing
+    recv_ns: np.ndarray  # bag (log) time of each grid point, non-decreasing
     missing: int  # grid points without a motion or force sample of their own (interpolated)
     velocity_source: str  # topic, or "difference of <motion topic>"
 

@@ -1,6 +1,6 @@
 """Which parameters were active when: steady segments of a session from its parameter events.
 
-Sources, in bag (receive) time order, for the nodes in the motion topic's namespace:
+Sources, in bag (log) time order, for the nodes in the motion topic's namespace:
 
 - ``new_parameters`` (the recorder's snapshot of every node, or a node declaring its parameters
   while ``ros2 bag record`` ran) give a parameter's value; the first value known of a
@@ -18,8 +18,10 @@ gain and output limit. Where a change takes effect:
   transit is repaired at the writer's next heartbeat, seconds later on a loaded machine); a
   device stamping its samples with the system clock gives the same with any node's events;
 - otherwise (a wall-clock stamp beside samples stamped from a run's start) at the first motion
-  sample the recorder received at or after the event (both carry the recorder's receive time),
-  within a few samples of the change when the event was not delayed in transit.
+  sample logged at or after the event: both carry the bag's log time, one time base in any bag
+  (``ros2 bag record``: the receive time; this suite's recorder: the session's time, the
+  samples at their stamps and the event at the newest stamp received before it), within a few
+  samples of the change when the event was not delayed in transit.
 """
 
 from __future__ import annotations
@@ -56,7 +58,7 @@ Params = dict[str, dict[str, Any]]  # node name -> parameter -> value
 
 @dataclass(frozen=True)
 class Change:
-    """Relevant parameters of one node that changed at bag time ``time_ns``."""
+    """Relevant parameters of one node that changed at bag (log) time ``time_ns``."""
 
     time_ns: int
     node: str
@@ -119,9 +121,9 @@ def split(
 ) -> list[Segment]:
     """Cut samples into segments at changes.
 
-    Sample ``i`` is stamped ``start_ns + i * period_ns`` (when given) and was received at
+    Sample ``i`` is stamped ``start_ns + i * period_ns`` (when given) and logged at
     ``recv_ns[i]`` (non-decreasing). A change stamped within the samples' stamps takes effect at
-    the first sample stamped at or after it, any other at the first sample received at or after
+    the first sample stamped at or after it, any other at the first sample logged at or after
     it; several changes landing on the same sample make one boundary; changes after the last
     sample are ignored.
     """

@@ -33,7 +33,7 @@ class Series:
     msgtype: str
     stamps_ns: np.ndarray  # int64 header stamps
     values: np.ndarray  # float64, one per stamp (the chosen coordinate)
-    recv_ns: np.ndarray  # int64 bag (receive) time of each kept message
+    recv_ns: np.ndarray  # int64 bag (log) time of each kept message
     duplicates: int = 0  # messages dropped because their stamp came again
 
 

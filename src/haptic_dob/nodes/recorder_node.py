@@ -3,22 +3,18 @@
 - Subscribes raw (serialized CDR) to each topic and writes the bytes as they are: reliable
   ``qos.RECORD`` for the loop's topics (a recorder that falls behind is repaired from the
   publishers' last 2000 samples), the parameter-events profile for ``/parameter_events``,
-  reliable volatile for other topics. Bag time is the receive time (wall clock, ns); the
-  analysis times samples by their header stamps.
-- Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``;
-  a node silent for ``snapshot_timeout_s`` is warned about and still asked) as a
-  ``rcl_interfaces/msg/ParameterEvent`` with all parameters in ``new_parameters``, on
-  ``/parameter_events`` beside the live events, so the bag says which stiffness, mode and gains
-  were active at every moment. Nodes that start later are snapshot when they appear.
-- Publishes ``recorder/progress`` (``std_msgs/Header``: the stamp, and this recorder's name in
-  ``frame_id`` so a device can follow the slowest of several; reliable, transient local) at
-  ``progress_rate_hz``: the newest stamp written, minimum over the stamped topics that are
-  flowing (header stamps; the effort command's ``effort@<stamp>`` label). A lockstep device
-  holds the loop while that lags, so a recorded lockstep run loses nothing. The report is held
-  where a node appeared until its parameters came (at most ``snapshot_timeout_s``), so a short
-  lockstep run cannot end before the bag knows the session's parameters. Before the first loop
-  sample it reports ``PROGRESS_NOT_MATCHED_NS`` while a reader has not matched its writers
-  (``haptic_dob.recorder.matching``): the device sends sample 0 only after that.
+  reliable volatile for other topics. Bag time: the session's (``log_time``, as ``ros2 bag
+  record --use-sim-time``; ``/clock`` is read where no loop topic is recorded) or receive time.
+- Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``,
+  when it appears; one silent for ``snapshot_timeout_s`` is warned about and still asked) as a
+  ``ParameterEvent`` with all parameters in ``new_parameters`` on ``/parameter_events``, so the
+  bag says which stiffness, mode and gains were active at every moment.
+- Publishes ``recorder/progress`` (``std_msgs/Header``: the newest stamp written, minimum over
+  the stamped topics flowing; its name in ``frame_id``) at ``progress_rate_hz``: a lockstep
+  device holds the loop while that lags, so a recorded lockstep run loses nothing. The report is
+  held where a node appeared until its parameters came (at most ``snapshot_timeout_s``). Before
+  the first loop sample it is ``PROGRESS_NOT_MATCHED_NS`` while a reader has not matched its
+  writers (``haptic_dob.recorder.matching``): the device sends sample 0 only after that.
 - On SIGINT/SIGTERM (or after ``duration_s``) it takes what is still queued (at most
   ``drain_timeout_s``, until nothing arrives for 0.1 s), then closes the bag so it is readable,
   and reports per topic what it received, wrote and which stamps are missing (gaps).
@@ -44,6 +40,7 @@ from rclpy.qos import (
     ReliabilityPolicy,
     qos_profile_parameter_events,
 )
+from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Header
 
 from haptic_dob.nodes.common import main_for
@@ -58,7 +55,7 @@ from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.raw import rclpy_type
 from haptic_msgs_py.stamps import NS_PER_S, period_ns
-from haptic_msgs_py.topics import RECORDER_PROGRESS
+from haptic_msgs_py.topics import CLOCK, RECORDER_PROGRESS
 
 PROGRESS_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
@@ -94,15 +91,20 @@ class RecorderNode(LoopNode):
                 classes[t.typename] = rclpy_type(t.typename)
             except (ImportError, AttributeError, ValueError):
                 raise ValueError(f"topics: {t.typename} is not an installed message type") from None
-        self.recording = Recording(new_bag_path(v["output"]), v["storage"], period_ns(v["rate_hz"]))
+        self.recording = Recording(
+            new_bag_path(v["output"]), v["storage"], period_ns(v["rate_hz"]), v["log_time"]
+        )
         self._t_end = time.monotonic() + v["duration_s"] if v["duration_s"] > 0 else None
         self._subs: list[tuple[Any, Callable[[bytes], None]]] = []
-        for t in topics:
-            resolved = self.resolve_topic_name(t.name)
-            cb = self.recording.add_topic(resolved, t.typename)
-            profile = SUBSCRIPTION_QOS[t.kind(resolved)]
+        kinds = [t.kind(self.resolve_topic_name(t.name)) for t in topics]
+        for t, kind in zip(topics, kinds, strict=True):
+            loop = kind is TopicKind.SESSION
+            cb = self.recording.add_topic(self.resolve_topic_name(t.name), t.typename, loop)
+            profile = SUBSCRIPTION_QOS[kind]
             sub = self.create_subscription(classes[t.typename], t.name, cb, profile, raw=True)
             self._subs.append((sub, cb))
+        if v["log_time"] == "session" and TopicKind.SESSION not in kinds:  # no loop stamps
+            self.create_subscription(Clock, CLOCK, self._on_clock, qos.CLOCK)
         self.snapshots: SnapshotTracker[Client] = SnapshotTracker(
             self.get_fully_qualified_name(),
             self.get_namespace(),
@@ -145,6 +147,9 @@ class RecorderNode(LoopNode):
         self._progress_msg.stamp.sec, self._progress_msg.stamp.nanosec = sec, nsec
         self._progress.publish(self._progress_msg)
         self.recording.keep_durable()  # at least once a second: a kill -9 loses at most that
+
+    def _on_clock(self, msg: Clock) -> None:
+        self.recording.observe_clock(msg.clock.sec * NS_PER_S + msg.clock.nanosec)
 
     # --- parameter snapshots ---------------------------------------------------------------
     def _on_discovery(self) -> None:

@@ -20,6 +20,7 @@ def record(
     topics: Sequence[str] | None = None,
     node_name: str = "recorder_node",
     rate_hz: float = 1000.0,
+    log_time: str = "session",
 ) -> tuple[int, RecorderNode | None]:
     """Run a recorder until SIGINT/SIGTERM or ``duration_s``; (exit code, the node if created)."""
     ensure_ament_prefix()
@@ -28,6 +29,7 @@ def record(
         Parameter("storage", value=storage),
         Parameter("duration_s", value=float(duration_s)),
         Parameter("rate_hz", value=float(rate_hz)),
+        Parameter("log_time", value=log_time),
     ]
     if topics is not None:
         overrides.append(Parameter("topics", value=list(topics)))

@@ -12,6 +12,7 @@ from haptic_dob.runtime.params import ParamSpec
 from haptic_msgs_py.topics import PARAMETER_EVENTS, SESSION_TOPICS
 
 STORAGES = ("mcap", "sqlite3")  # bag storages (``haptic_dob.bag.write.open_writer``)
+LOG_TIMES = ("session", "receive")  # a message's bag time (``haptic_dob.recorder.recording``)
 DEFAULT_TOPICS = [*SESSION_TOPICS, PARAMETER_EVENTS]  # every session topic and the events
 
 
@@ -25,6 +26,15 @@ def recorder_specs() -> list[ParamSpec]:
             read_only=True,
         ),
         ParamSpec("storage", "mcap", "bag storage", choices=STORAGES, read_only=True),
+        ParamSpec(
+            "log_time",
+            "session",
+            "bag time of each message: session = the session's time (a loop message's own "
+            "stamp, anything else the newest stamp or /clock received; as ros2 bag record "
+            "--use-sim-time), receive = the wall-clock receive time (as ros2 bag record)",
+            choices=LOG_TIMES,
+            read_only=True,
+        ),
         ParamSpec(
             "topics",
             list(DEFAULT_TOPICS),

@@ -59,7 +59,7 @@ from haptic_msgs_py.values import JointSample, Stamp, StampedVector
 from haptic_sim.cycle_stats import CycleStats
 from haptic_sim.device import DeviceSample
 from haptic_sim.device_loop import DeviceLoop
-from haptic_sim.device_settings import DeviceLoopSettings, device_node_specs
+from haptic_sim.device_settings import DeviceLoopSettings, device_node_specs, missing_nodes
 from haptic_sim.factory import build_device
 
 
@@ -160,8 +160,7 @@ class DeviceNode(LoopNode):
         """What the start still waits for ('' when nothing)."""
         wait_for = self.params.values["wait_for"]
         ns = self.get_namespace()
-        names = {n for n, space in self.get_node_names_and_namespaces() if space == ns}
-        missing = [w for w in wait_for if w not in names]
+        missing = missing_nodes(wait_for, self.get_node_names_and_namespaces(), ns)
         if missing:
             return f"node{'s' if len(missing) > 1 else ''} {', '.join(missing)} in {ns}"
         for pub in self._bus.publishers():  # this node's and any composed with it

@@ -3,9 +3,13 @@
 The simulated session graph for the ROS 2 command line, the same plan as ``haptic-launch``
 (which needs no ROS 2 command line), from the same YAML: the loop's nodes (device, environment,
 observer, controller) in one process (``ros2 run haptic_dob container``, their messages handed
-over in process) unless ``composed:=false``, a recorder apart, in ``namespace``. Every process
-is required: when the device finishes a lockstep run (``duration_s``) or any node process ends
-(a crash, a kill), the launch shuts the whole graph down, as ``haptic-launch`` does.
+over in process) unless ``composed:=false``, in ``namespace``. Every process is required: when
+the device finishes a lockstep run (``duration_s``) or any node process ends (a crash, a kill),
+the launch shuts the whole graph down, as ``haptic-launch`` does.
+
+It starts no recorder (``haptic-launch --record`` does). To record, start one first in its own
+terminal (``ros2 run haptic_dob recorder_node --ros-args -p output:=BAG``, or ``ros2 bag record``
+as docs/running.md says) and give a config whose ``device_node`` ``wait_for`` names it.
 """
 
 import tempfile
