@@ -73,4 +73,6 @@ def test_the_teleop_graph_in_lockstep_equals_the_batch_run(root, tmp_path, layou
     assert np.array_equal(slave_q, batch.slave_q)
     # the cycle contract on the wire: the slave's effort of sample k+1 is its command k
     assert np.array_equal(slave_effort, batch.slave_command)
-    assert batch.dissipated[-1] >= 0.0 and np.any(batch.contact[:, 2] > 0.0)  # it touched
+    # the passivity controller acted (dissipated energy) and the slave touched the table, so the
+    # equality above covers both
+    assert batch.dissipated[-1] > 0.0 and np.any(batch.contact[:, 2] > 0.0)

@@ -200,6 +200,59 @@ def test_a_silent_peer_zeroes_the_master_force_and_the_slave_holds() -> None:
             assert not master.peer_silent
 
 
+def test_after_a_silence_the_slave_goes_on_from_where_it_held_and_the_force_ramps_back() -> None:
+    """A 20-sample outage (all messages lost) while the master moves 1 mm per sample: back, the
+    slave's target moves on by one sample of the master's motion, not the outage's 20 mm, and
+    the master's force comes back linearly over the timeout."""
+    master, slave = ends(round_trip_delay_ms=2.0, timeout_s=0.005)
+    here = (0.5, 0.0, 0.4)
+    targets, forces = [], []
+    for k in range(80):
+        fw, to_slave = master.cycle(k * PERIOD, (0.001 * k, 0.0, 0.0), (1.0, 0.0, 0.0))
+        target, to_master = slave.cycle(k * PERIOD, here, (0.0, 0.0, 0.0), (0.0, 0.0, 10.0))
+        if not 30 <= k < 50:  # the outage: every message of samples 30..49 is lost
+            slave.receive(to_slave)
+            master.receive(to_master)
+        targets.append(target[2])
+        forces.append(fw[0])
+    assert slave.holding is False and not master.peer_silent
+    held = targets[40]  # silent by then (the last message, 29, arrived at 30; 5 samples + 1)
+    assert targets[49] == held  # held through the outage
+    steps = np.diff(targets[50:60])
+    assert np.all(np.abs(steps) <= 0.002 + 1e-12)  # one sample of the master's motion (x2), no jump
+    assert abs(targets[51] - held) < 0.005  # not the outage's 40 mm (20 mm doubled)
+    ramp = forces[51:57]  # the first message back is due at 51: 1/5, 2/5 ... of the full -1 N
+    assert ramp == pytest.approx([-0.2, -0.4, -0.6, -0.8, -1.0, -1.0])
+    assert forces[45] == 0.0
+
+
+def test_passivity_control_is_refused_for_position_position() -> None:
+    teleop = TeleopSettings(architecture="position_position")
+    with pytest.raises(ValueError, match="position_force"):
+        MasterEnd(teleop, ChannelSettings(passivity=True), PERIOD)
+    with pytest.raises(ValueError, match="position_force"):
+        SlaveEnd(teleop, ChannelSettings(passivity=True), PERIOD)
+
+
+def test_the_master_port_books_no_more_than_the_master_can_render() -> None:
+    """A 100 N slave force with force_scale 0.1 asks 10 N of a 4 N master: the port's force (slave
+    units) is limited to 40 N, the force the master renders."""
+    master, slave = ends()
+    for k in range(3):
+        fw, _ = master.cycle(k * PERIOD, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0))
+        _, to_master = slave.cycle(k * PERIOD, (0.5, 0.0, 0.4), (0.0, 0.0, 0.0), (0.0, 0.0, 100.0))
+        master.receive(to_master)
+    assert master.force_sent == pytest.approx((0.0, 0.0, 40.0))
+    assert fw == pytest.approx((-4.0, 0.0, 0.0))
+
+
+def test_the_delay_rounds_half_up_and_reports_what_it_simulates() -> None:
+    assert ChannelSettings(round_trip_delay_ms=5.0).delay_samples(PERIOD) == 3
+    assert ChannelSettings(round_trip_delay_ms=5.0).simulated_round_trip_ms(PERIOD) == 6.0
+    assert ChannelSettings(round_trip_delay_ms=25.0).delay_samples(PERIOD) == 13
+    assert ChannelSettings(round_trip_delay_ms=50.0).simulated_round_trip_ms(PERIOD) == 50.0
+
+
 # --- the slave's law -------------------------------------------------------------------------
 def test_the_slave_law_holds_its_start_and_has_every_mode_at_the_bandwidth() -> None:
     model = UrdfModel(ARM7, "tool")

@@ -75,11 +75,18 @@ class TeleopConfig:
         if loop.rate_hz != slave_loop.rate_hz or loop.duration_s != slave_loop.duration_s:
             raise ValueError("master and slave devices need the same rate_hz and duration_s")
         contact = build(VirtualWall, {**NO_CONTACT, **s_dev}, "contact.")
+        master_law = build(ImpedanceLaw, of("master", "controller_node"))
+        if ends[0][0].master_max_force_n != master_law.max_force_n:
+            raise ValueError(
+                f"teleop.master_max_force_n ({ends[0][0].master_max_force_n:g} N) must be the "
+                f"master controller's max_force_n ({master_law.max_force_n:g} N): the channel "
+                "books what the master can render"
+            )
         return cls(
             sections=secs,
             loop=loop,
             slave_loop=slave_loop,
-            master_law=build(ImpedanceLaw, of("master", "controller_node")),
+            master_law=master_law,
             master_observer=build(ObserverSettings, of("master", "observer_node")),
             slave_observer=build(ObserverSettings, of("slave", "observer_node")),
             slave=build(SlaveImpedance, of("slave", "slave_controller_node"), "slave."),

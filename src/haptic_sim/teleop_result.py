@@ -27,6 +27,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy import signal
 
+from haptic_msgs_py.stamps import period_ns
+
 if TYPE_CHECKING:
     from haptic_sim.teleop_config import TeleopConfig
 
@@ -118,7 +120,7 @@ class TeleopResult:
         return TeleopMetrics(
             architecture=cfg.teleop.architecture,
             force_source=cfg.teleop.force_source,
-            round_trip_delay_ms=cfg.channel.round_trip_delay_ms,
+            round_trip_delay_ms=cfg.channel.simulated_round_trip_ms(period_ns(cfg.loop.rate_hz)),
             passivity=cfg.channel.passivity,
             duration_s=self.t.size / fs,
             contact_pct=float(np.mean(touch) * 100.0),

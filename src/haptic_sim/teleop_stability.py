@@ -16,6 +16,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 from haptic_dob.validation import nonnegative, positive
+from haptic_msgs_py.stamps import period_ns
 from haptic_sim.teleop_config import TeleopConfig
 from haptic_sim.teleop_session import run_teleop
 
@@ -68,7 +69,7 @@ class DelayProtocol:
 class DelayPoint:
     """The loop at one delay, with or without passivity control."""
 
-    round_trip_delay_ms: float
+    round_trip_delay_ms: float  # as simulated: whole samples each way
     passivity: bool
     oscillation_mm: float
     channel_energy_min_j: float
@@ -81,9 +82,10 @@ def delay_point(
     protocol: DelayProtocol, base: TeleopConfig, delay_ms: float, passivity: bool
 ) -> DelayPoint:
     """Run the protocol at one delay."""
-    m = run_teleop(protocol.config(base, delay_ms, passivity)).metrics()
+    config = protocol.config(base, delay_ms, passivity)
+    m = run_teleop(config).metrics()
     return DelayPoint(
-        float(delay_ms),
+        config.channel.simulated_round_trip_ms(period_ns(config.loop.rate_hz)),
         bool(passivity),
         m.oscillation_mm,
         m.channel_energy_min_j,

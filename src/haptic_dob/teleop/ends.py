@@ -13,16 +13,21 @@ Both ends book their port's energy and, with ``channel.passivity``, enforce it
 (``haptic_dob.teleop.passivity``). The master's port: flow the master's velocity, effort the
 force it renders (scaled to slave units). The slave's port: flow the velocity of the point it is
 told to track, effort the slave's contact force. When its peer is silent for ``timeout_s`` a side
-stops using it: the master renders zero force, the slave holds the point where it is (and goes on
-from there, without a jump, when messages come again).
+stops using it: the master renders zero force, the slave holds the point where it is. When
+messages come again the slave goes on from the held point (the master's motion during the
+silence is not replayed) and the master's force comes back over ``timeout_s`` (a linear ramp).
+Passivity control is for ``position_force``: under ``position_position`` the two ports' efforts
+(the master's coupling force, the slave's contact force) are not one port's, so both ends
+refuse it.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import NamedTuple
 
-from haptic_dob.control import ZERO_FORCE, Force
+from haptic_dob.control import ZERO_FORCE, Force, limit_norm
 from haptic_dob.teleop.delay import DelayLine, _quiet
 from haptic_dob.teleop.passivity import PassivityPort
 from haptic_dob.teleop.settings import ChannelSettings, TeleopSettings
@@ -64,6 +69,11 @@ class _End:
         lost: Callable[[str], None],
         back: Callable[[], None],
     ) -> None:
+        if channel.passivity and teleop.architecture == "position_position":
+            raise ValueError(
+                "channel.passivity is built for teleop.architecture position_force: under "
+                "position_position the ports' efforts are not one port's"
+            )
         self.teleop = teleop
         self.period_ns = period_ns
         self.dt = period_ns * 1e-9
@@ -115,6 +125,12 @@ class MasterEnd(_End):
         self._Rt: tuple[Vec3, Vec3, Vec3] = tuple(tuple(r) for r in m.T.tolist())  # type: ignore[assignment]  # 3x3
         self.axis = axis
         self.force_sent: Force = ZERO_FORCE  # the port's force this cycle (slave units, N)
+        # what the master can render, in slave units: the port books no more (N)
+        self._limit_n = (
+            teleop.master_max_force_n / teleop.force_scale if teleop.force_scale > 0.0 else math.inf
+        )
+        self._ramp = max(1, math.ceil(channel.timeout_s * 1e9 / period_ns))  # samples
+        self._since_back = self._ramp  # samples since the slave came back (full force)
 
     def cycle(self, stamp_ns: int, position: Vec3, velocity: Vec3) -> tuple[Force, PortMessage]:
         """Sample k's point (m) and velocity (m/s), master frame -> the wall force the master
@@ -129,16 +145,24 @@ class MasterEnd(_End):
         msg = self._incoming(stamp_ns // self.period_ns)
         if msg is None:
             f: Force = ZERO_FORCE
-        elif t.architecture == "position_force":
-            f = msg.force
+            if self.peer_silent:  # its force comes back over the ramp
+                self._since_back = 0
         else:
-            k, b = t.coupling_n_per_m, t.coupling_n_s_per_m
-            p, w = msg.position, msg.velocity
-            f = (
-                k * (p[0] - x[0]) + b * (w[0] - v[0]),
-                k * (p[1] - x[1]) + b * (w[1] - v[1]),
-                k * (p[2] - x[2]) + b * (w[2] - v[2]),
-            )
+            if t.architecture == "position_force":
+                f = msg.force
+            else:
+                k, b = t.coupling_n_per_m, t.coupling_n_s_per_m
+                p, w = msg.position, msg.velocity
+                f = (
+                    k * (p[0] - x[0]) + b * (w[0] - v[0]),
+                    k * (p[1] - x[1]) + b * (w[1] - v[1]),
+                    k * (p[2] - x[2]) + b * (w[2] - v[2]),
+                )
+            if self._since_back < self._ramp:  # back after a silence: ramp the force in
+                self._since_back += 1
+                r = self._since_back / self._ramp
+                f = (f[0] * r, f[1] * r, f[2] * r)
+            f = limit_norm(f, self._limit_n)
         f = self.port.impedance(f, v)
         self.force_sent = f
         fw = _rotate(self._Rt, t.force_scale, f)
@@ -182,8 +206,10 @@ class SlaveEnd(_End):
                 self.target = position
             self.port.admittance(ZERO_FORCE, force)  # no flow: books nothing
         else:
-            self.holding = False
             d = msg.position if msg is not None else self._disp
+            if self.holding:  # back after a silence: go on from the held point, no jump
+                self.holding = False
+                self._disp = d
             d0 = self._disp
             T = self.dt
             v = ((d[0] - d0[0]) / T, (d[1] - d0[1]) / T, (d[2] - d0[2]) / T)

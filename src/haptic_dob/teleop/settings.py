@@ -57,6 +57,16 @@ class TeleopSettings:
     force_scale: float = field(
         default=1.0, metadata=param("master force per slave force", "", 0.0, 1e3)
     )
+    master_max_force_n: float = field(
+        default=4.0,
+        metadata=param(
+            "the largest force the master renders (its controller's max_force_n, master "
+            "units): the channel books no more than it renders",
+            "N",
+            1e-3,
+            1e4,
+        ),
+    )
     coupling_n_per_m: float = field(
         default=1000.0,
         metadata=param(
@@ -88,6 +98,7 @@ class TeleopSettings:
         object.__setattr__(self, "rotation", tuple(float(x) for x in r))
         positive("position_scale", self.position_scale)
         nonnegative("force_scale", self.force_scale)
+        positive("master_max_force_n", self.master_max_force_n)
         nonnegative("coupling_n_per_m", self.coupling_n_per_m)
         nonnegative("coupling_n_s_per_m", self.coupling_n_s_per_m)
 
@@ -160,8 +171,12 @@ class ChannelSettings:
             )
 
     def delay_samples(self, period_ns: int) -> int:
-        """One-way delay (samples): half the round trip, at least 1."""
-        return max(1, round(self.round_trip_delay_ms * 1e6 / 2.0 / period_ns))
+        """One-way delay (samples): half the round trip, rounded half up, at least 1."""
+        return max(1, math.floor(self.round_trip_delay_ms * 1e6 / 2.0 / period_ns + 0.5))
+
+    def simulated_round_trip_ms(self, period_ns: int) -> float:
+        """The round trip the channel gives (ms): twice the one-way delay in whole samples."""
+        return 2.0 * self.delay_samples(period_ns) * period_ns * 1e-6
 
     def jitter_samples(self, period_ns: int) -> int:
         """The largest extra one-way delay (samples)."""
