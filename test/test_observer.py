@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from haptic_dob.models import DeviceModel, SlideModel, SlideParams
-from haptic_dob.observer import DisturbanceObserver, dls_transpose_solve
+from haptic_dob.observer import DisturbanceObserver
+from haptic_dob.tip_force import dls_transpose_solve
 from haptic_sim.hand import HandParams
 from haptic_sim.slide import SimulatedSlide, SlideDeviceParams
 

@@ -28,8 +28,9 @@ from haptic_dob.environment import VirtualWall
 from haptic_dob.models.base import DeviceModel
 from haptic_dob.models.factory import build_model
 from haptic_dob.models.phantom import PhantomModel
-from haptic_dob.observer import ObserverSettings, dls_transpose_solve
+from haptic_dob.observer import ObserverSettings
 from haptic_dob.runtime.params import build, load_node_params, node_view, replace_groups
+from haptic_dob.tip_force import dls_transpose_solve
 from haptic_sim.arm import ArmDeviceParams, SimulatedArm
 from haptic_sim.hand import HandParams
 from haptic_sim.sensor import ForceSensorParams

@@ -32,7 +32,8 @@ import numpy as np
 from haptic_dob.control import ControlMode, ImpedanceLaw
 from haptic_dob.environment import VirtualWall
 from haptic_dob.models.phantom import HOME, PhantomModel
-from haptic_dob.observer import ObserverSettings, dls_transpose_solve
+from haptic_dob.observer import ObserverSettings
+from haptic_dob.tip_force import dls_transpose_solve
 from haptic_sim.arm import ArmDeviceParams
 from haptic_sim.arm_session import ArmSessionConfig, ArmSessionResult, run_arm_session
 from haptic_sim.session import LoopSettings
