@@ -28,6 +28,9 @@ def _stub_modules(monkeypatch, launch_args: dict[str, str]) -> None:
     actions.DeclareLaunchArgument = _Recorder
     actions.OpaqueFunction = _Recorder
     actions.Shutdown = _Recorder
+    actions.RegisterEventHandler = _Recorder
+    handlers = types.ModuleType("launch.event_handlers")
+    handlers.OnShutdown = _Recorder
     subs = types.ModuleType("launch.substitutions")
 
     class LaunchConfiguration:
@@ -44,6 +47,7 @@ def _stub_modules(monkeypatch, launch_args: dict[str, str]) -> None:
     for name, mod in {
         "launch": launch,
         "launch.actions": actions,
+        "launch.event_handlers": handlers,
         "launch.substitutions": subs,
         "launch_ros": ros,
         "launch_ros.actions": ros_actions,
@@ -51,7 +55,11 @@ def _stub_modules(monkeypatch, launch_args: dict[str, str]) -> None:
         monkeypatch.setitem(sys.modules, name, mod)
 
 
-def _plan(monkeypatch, **launch_args: str) -> list:
+def _plan(monkeypatch, **launch_args: str) -> tuple[list, dict]:
+    """The processes the launch file asks for, and the params file they share (read before the
+    launch's shutdown removes it)."""
+    import yaml
+
     path = Path(get_package_share_directory("haptic_dob")) / "launch" / "session.launch.py"
     assert path.is_file()
     _stub_modules(monkeypatch, {"config": "slide_sim", "namespace": "slide1", **launch_args})
@@ -60,11 +68,28 @@ def _plan(monkeypatch, **launch_args: str) -> list:
     spec.loader.exec_module(module)
     ld = module.generate_launch_description()
     opaque = ld.args[0][-1]
-    return opaque.kwargs["function"](context=None)
+    cleanup, *nodes = opaque.kwargs["function"](context=None)
+    # the params file's folder goes when the launch shuts down
+    (on_shutdown,) = cleanup.args
+    params_file = Path(nodes[0].kwargs["parameters"][0])
+    doc = yaml.safe_load(params_file.read_text())
+    on_shutdown.kwargs["on_shutdown"](None, None)
+    assert not params_file.parent.exists()
+    return nodes, doc
+
+
+def _ends_graph_once(node) -> str:
+    """The process's on_exit shuts the launch down, unless it is already shutting down; the
+    reason it gives."""
+    on_exit = node.kwargs["on_exit"]
+    assert on_exit(None, types.SimpleNamespace(is_shutdown=True)) is None
+    action = on_exit(None, types.SimpleNamespace(is_shutdown=False))
+    assert type(action).__name__ == "_Recorder"
+    return action.kwargs["reason"]
 
 
 def test_launch_file_is_installed_and_plans_the_session(monkeypatch) -> None:
-    nodes = _plan(monkeypatch, composed="false")
+    nodes, doc = _plan(monkeypatch, composed="false")
     planned = [(n.kwargs["package"], n.kwargs["executable"], n.kwargs["namespace"]) for n in nodes]
     assert planned == [
         ("haptic_dob", "environment_node", "slide1"),
@@ -72,12 +97,18 @@ def test_launch_file_is_installed_and_plans_the_session(monkeypatch) -> None:
         ("haptic_dob", "controller_node", "slide1"),
         ("haptic_sim", "device_node", "slide1"),
     ]
-    device = nodes[-1].kwargs["parameters"][0]
-    assert device["clock_mode"] == "lockstep" and device["rate_hz"] == 1000.0
+    assert [n.kwargs["name"] for n in nodes] == [
+        "environment_node",
+        "observer_node",
+        "controller_node",
+        "device_node",
+    ]
+    assert len({n.kwargs["parameters"][0] for n in nodes}) == 1  # one params file ...
+    device = doc["/**/device_node"]["ros__parameters"]  # ... that any namespace matches
+    assert device["clock_mode"] == "lockstep" and doc["/**"]["ros__parameters"]["rate_hz"] == 1000
     assert device["hand.behaviour"] == "semi_random"
     for n in nodes:  # every process is required: its end shuts the launch down
-        assert type(n.kwargs["on_exit"]).__name__ == "_Recorder", n.kwargs
-        assert "ended" in n.kwargs["on_exit"].kwargs["reason"]
+        assert "ended" in _ends_graph_once(n)
     for pkg, exe, _ in planned:
         shim = Path(get_package_share_directory(pkg)).parents[1] / "lib" / pkg / exe
         assert shim.is_file(), shim
@@ -85,9 +116,7 @@ def test_launch_file_is_installed_and_plans_the_session(monkeypatch) -> None:
 
 def test_launch_file_composes_the_loop_by_default(monkeypatch) -> None:
     """As haptic-launch: the loop's nodes in the container, with a params file by node name."""
-    import yaml
-
-    (node,) = _plan(monkeypatch, composed="true")
+    (node,), doc = _plan(monkeypatch, composed="true")
     assert (node.kwargs["package"], node.kwargs["executable"]) == ("haptic_dob", "container")
     assert node.kwargs["arguments"] == [
         "environment_node",
@@ -96,9 +125,9 @@ def test_launch_file_composes_the_loop_by_default(monkeypatch) -> None:
         "device_node",
     ]
     assert node.kwargs["namespace"] == "slide1" and "name" not in node.kwargs
-    assert "device_node" in node.kwargs["on_exit"].kwargs["reason"]
+    assert "device_node" in _ends_graph_once(node)
     (params_file,) = node.kwargs["parameters"]
-    doc = yaml.safe_load(Path(params_file).read_text())
+    assert params_file.endswith("params.yaml")
     assert doc["/**/device_node"]["ros__parameters"]["clock_mode"] == "lockstep"
     assert doc["/**/environment_node"]["ros__parameters"]["stiffness_n_per_m"] == 800.0
     shim = Path(get_package_share_directory("haptic_dob")).parents[1] / "lib" / "haptic_dob"

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -74,6 +75,47 @@ def test_executable_resolves_starts_and_stops_on_sigint(package: str, name: str)
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait(5)
+
+
+@pytest.mark.parametrize("after_exec_s", [0.0, 0.02, 0.04, 0.06, 0.1])
+def test_ctrl_c_before_the_node_code_runs_prints_nothing(after_exec_s: float) -> None:
+    """A SIGINT while the interpreter starts (its site packages, the console script's imports:
+    before the entry point can set its quiet handler; here some 40-60 ms after the shim's exec,
+    where Python printed a KeyboardInterrupt traceback and exited 1) prints nothing: the shim
+    keeps SIGINT ignored until the entry point takes it, and a second SIGINT once rclpy is
+    loaded ends the node quietly. The delays after the exec are the stimulus, not a bound."""
+    exe = Path(get_package_prefix("haptic_dob")) / "lib" / "haptic_dob" / "controller_node"
+    proc = subprocess.Popen(
+        [str(exe)], env=isolated_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT
+    )
+    try:
+        wait_until(lambda: _is_python(proc.pid), 30.0, poll_s=0.0005)  # a hang guard
+        time.sleep(after_exec_s)
+        proc.send_signal(signal.SIGINT)
+        # a hang guard: the node ends, or goes on starting
+        wait_until(
+            lambda: proc.poll() is not None or _mapped(proc.pid, PHASES["rclpy_loaded"]),
+            60.0,
+            poll_s=0.002,
+        )
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=30)  # a lost second signal: TimeoutExpired
+        assert b"Traceback" not in out and b"KeyboardInterrupt" not in out, out.decode()
+        assert b"Fatal Python error" not in out, out.decode()
+        assert proc.returncode in (0, 130), (proc.returncode, out.decode())
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(5)
+
+
+def _is_python(pid: int) -> bool:
+    """Whether process ``pid`` runs the Python interpreter (the shim has exec'd it)."""
+    try:
+        return "python" in os.readlink(f"/proc/{pid}/exe")
+    except OSError:
+        return False
 
 
 def _mapped(pid: int, library: str) -> bool:

@@ -12,3 +12,9 @@ if [ -z "${_ROS_WHEELS_BOOTSTRAP_COMPLETE:-}" ]; then
     _ROS_WHEELS_BOOTSTRAP_COMPLETE=1
     export LD_LIBRARY_PATH _ROS_WHEELS_BOOTSTRAP_COMPLETE
 fi
+# A Ctrl-C (ros2 launch, a terminal) that comes before the node's entry point has set its quiet
+# handler would make Python print a KeyboardInterrupt traceback from its own start-up (its site
+# packages, the entry point's imports). SIGINT stays ignored until then: Python keeps an ignored
+# SIGINT ignored, and haptic_dob.runtime.entry.run_main takes it over. A Ctrl-C in those first
+# moments is lost; ros2 launch follows it with SIGTERM, a terminal's user presses again.
+trap '' INT

@@ -2,20 +2,24 @@
 
 ``ros2 launch`` and a terminal send SIGINT to a node that may still be importing numpy,
 pinocchio and rclpy; Python would print a ``KeyboardInterrupt`` traceback. ``run_main`` installs
-a SIGINT handler that exits with status 130 (128 + SIGINT) *before* importing the node's module;
-the node's runtime (``haptic_dob.runtime.ros.spin.run_nodes``) replaces it with its clean shutdown
-once the node is up. ROS-free and light: it imports the module only by name.
+a SIGINT handler that leaves at once with status 130 (128 + SIGINT) *before* importing the node's
+module (``os._exit``: an exception raised in the middle of an extension's import would surface as
+a chained ``ImportError``); the node's runtime (``haptic_dob.runtime.ros.spin.run_nodes``)
+replaces it with its clean shutdown once the node is up. The ``ros2 run`` shims (``ros/lib``)
+keep SIGINT ignored from the shell to here, over the interpreter's own start-up. ROS-free and
+light: it imports the module only by name.
 """
 
 from __future__ import annotations
 
 import importlib
+import os
 import signal
 from types import FrameType
 
 
 def _leave(signum: int, _frame: FrameType | None) -> None:
-    raise SystemExit(128 + signum)
+    os._exit(128 + signum)  # nothing to clean up yet: the node does not exist
 
 
 def run_main(module: str) -> int:

@@ -12,17 +12,25 @@ terminal (``ros2 run haptic_dob recorder_node --ros-args -p output:=BAG``, or ``
 as docs/running.md says) and give a config whose ``device_node`` ``wait_for`` names it.
 """
 
+import shutil
 import tempfile
 from pathlib import Path
 
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, OpaqueFunction, Shutdown
+from launch.actions import DeclareLaunchArgument, OpaqueFunction, RegisterEventHandler, Shutdown
+from launch.event_handlers import OnShutdown
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 from haptic_dob.configs import resolve_config
 from haptic_dob.launcher import NODES, START_ORDER, groups_for, resolved_params, write_params_file
 from haptic_dob.nodes.registry import CONTAINER
+
+
+def _end_graph(reason):
+    """What a process's exit does: shut the launch down, once (not again for each process that
+    ends during the shutdown)."""
+    return lambda _event, context: None if context.is_shutdown else Shutdown(reason=reason)
 
 
 def _nodes(context, *args, **kwargs):
@@ -32,14 +40,20 @@ def _nodes(context, *args, **kwargs):
     if composed not in ("true", "false"):
         raise ValueError(f"composed must be true or false, got {composed!r}")
     params = resolved_params(config, {})
-    common = params.get("/**", {})
     names = [n for n in START_ORDER if n in params]
     groups = [
         [n for n in START_ORDER if n in g]  # in start order, as haptic-launch plans them
         for g in groups_for(names, False, composed == "false", ())
         if len(g) > 1
     ]
-    out = []
+    # one params file for every process, removed when the launch ends
+    folder = Path(tempfile.mkdtemp(prefix="haptic-launch-"))
+    params_file = str(write_params_file(params, folder))
+    out = [
+        RegisterEventHandler(
+            OnShutdown(on_shutdown=lambda _ev, _ctx: shutil.rmtree(folder, ignore_errors=True))
+        )
+    ]
     for name in names:
         group = next((g for g in groups if name in g), None)
         if group is None:
@@ -50,22 +64,21 @@ def _nodes(context, *args, **kwargs):
                     executable=executable,
                     name=name,
                     namespace=namespace,
-                    parameters=[{**common, **params[name]}],
+                    parameters=[params_file],
                     output="screen",
-                    on_exit=Shutdown(reason=f"{name} ended"),
+                    on_exit=_end_graph(f"{name} ended"),
                 )
             )
         elif name == group[-1]:  # one process for the group, where its last node would start
-            folder = Path(tempfile.mkdtemp(prefix="haptic-launch-"))
             out.append(
                 Node(
                     package=CONTAINER[0],
                     executable=CONTAINER[1],
                     arguments=list(group),
                     namespace=namespace,
-                    parameters=[str(write_params_file(params, folder))],
+                    parameters=[params_file],
                     output="screen",
-                    on_exit=Shutdown(reason=f"{', '.join(group)} ended"),
+                    on_exit=_end_graph(f"{', '.join(group)} ended"),
                 )
             )
     return out
