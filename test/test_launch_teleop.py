@@ -9,12 +9,13 @@ import yaml
 from haptic_dob.cli import CliError
 from haptic_dob.launcher.options import LaunchOptions
 from haptic_dob.launcher.teleop import (
+    add_teleop_recorder,
     teleop_command,
     teleop_params,
     teleop_plan,
     write_teleop_params,
 )
-from haptic_dob.teleop.graph import load_teleop_sections
+from haptic_dob.teleop.graph import RECORDER, load_teleop_sections
 
 
 @pytest.fixture
@@ -61,12 +62,35 @@ def test_composed_by_default_one_process_each_with_processes(sections, tmp_path)
     assert dev.args[-4:] == ["-r", "__ns:=/slave", "-r", "__node:=device_node"]
 
 
+def test_record_adds_a_recorder_of_both_sides_apart_that_both_devices_wait_for(
+    sections, tmp_path
+) -> None:
+    params = teleop_params(sections, [])
+    add_teleop_recorder(params, str(tmp_path / "bag"), "mcap")
+    rec = params["recorder_node"]
+    assert rec["namespaces"] == ["/master", "/slave"] and rec["rate_hz"] == 1000.0
+    topics = [t.partition(":")[0] for t in rec["topics"]]
+    for name in ("/master/joint_states", "/slave/sim/hand_wrench", "/slave/pose_desired"):
+        assert name in topics
+    assert {"/teleop/to_slave", "/teleop/to_master", "/parameter_events"} <= set(topics)
+    for ns in ("master", "slave"):
+        assert params[f"{ns}/device_node"]["wait_for"][-1] == RECORDER
+    path = write_teleop_params(params, tmp_path)
+    assert "/recorder_node" in yaml.safe_load(path.read_text())
+    for processes in (False, True):
+        plan = teleop_plan(params, path, processes)
+        assert plan[0].nodes == ["recorder_node"]  # first, alone, in the root namespace
+        assert plan[0].executable.endswith("recorder_node") and "__ns:=" not in plan[0].args
+        assert all("recorder_node" not in s.nodes for s in plan[1:])
+    with pytest.raises(CliError, match="exists already"):
+        add_teleop_recorder(params, str(tmp_path), "mcap")
+
+
 @pytest.mark.parametrize(
     ("option", "flag"),
     [
         ({"namespace": "x"}, "--namespace"),
         ({"only": ("device_node",)}, "--only"),
-        ({"record": "bag"}, "--record"),
         ({"groups": ("a,b",)}, "--group"),
     ],
 )

@@ -8,7 +8,13 @@ from pathlib import Path
 import pytest
 
 from haptic_dob.bag.write import open_writer
-from haptic_dob.recorder.settings import DEFAULT_TOPICS, STORAGES, new_bag_path, recorder_specs
+from haptic_dob.recorder.settings import (
+    DEFAULT_TOPICS,
+    STORAGES,
+    new_bag_path,
+    progress_topic,
+    recorder_specs,
+)
 
 
 def test_parameters() -> None:
@@ -17,6 +23,7 @@ def test_parameters() -> None:
         "output",
         "storage",
         "topics",
+        "namespaces",
         "duration_s",
         "rate_hz",
         "progress_rate_hz",
@@ -26,6 +33,12 @@ def test_parameters() -> None:
     assert specs["storage"].choices == STORAGES
     assert specs["topics"].default == DEFAULT_TOPICS and specs["topics"].length is None
     assert [n for n, s in specs.items() if not s.read_only] == ["rate_hz"]
+    assert specs["namespaces"].default == [""]  # its own
+
+
+def test_progress_goes_to_the_own_namespace_or_each_given_one() -> None:
+    assert progress_topic("") == "recorder/progress"  # relative: the recorder's namespace
+    assert progress_topic("/master") == progress_topic("/master/") == "/master/recorder/progress"
 
 
 def test_every_storage_opens(tmp_path: Path) -> None:

@@ -82,7 +82,8 @@ def schedule_specs() -> list[ParamSpec]:
         ParamSpec(
             "wait_for",
             list(DEFAULT_WAIT_FOR),
-            "nodes (in this namespace) that must be up before sample 0, in both clock modes "
+            "nodes (in this namespace, or /ns/node) that must be up before sample 0, in both "
+            "clock modes "
             "(realtime with []: tick at once, the watchdog holds zero effort until commands come)",
             read_only=True,
         ),

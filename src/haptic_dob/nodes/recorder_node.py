@@ -5,12 +5,12 @@
   publishers' last 2000 samples), the parameter-events profile for ``/parameter_events``,
   reliable volatile for other topics. Bag time is the receive time (wall clock, ns); the
   analysis times samples by their header stamps.
-- Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``;
-  a node silent for ``snapshot_timeout_s`` is warned about and still asked) as a
+- Writes a snapshot of every node in its ``namespaces`` (default its own; ``list_parameters`` +
+  ``get_parameters``; a node silent for ``snapshot_timeout_s`` is warned about and still asked) as a
   ``rcl_interfaces/msg/ParameterEvent`` with all parameters in ``new_parameters``, on
   ``/parameter_events`` beside the live events, so the bag says which stiffness, mode and gains
   were active at every moment. Nodes that start later are snapshot when they appear.
-- Publishes ``recorder/progress`` (``std_msgs/Header``: the stamp, and this recorder's name in
+- Publishes ``recorder/progress`` in each of them (``std_msgs/Header``: the stamp, and its name in
   ``frame_id`` so a device can follow the slowest of several; reliable, transient local) at
   ``progress_rate_hz``: the newest stamp written, minimum over the stamped topics that are
   flowing (header stamps; the effort command's ``effort@<stamp>`` label). A lockstep device
@@ -50,7 +50,7 @@ from haptic_dob.nodes.common import main_for
 from haptic_dob.recorder.drain import take_until_quiet
 from haptic_dob.recorder.matching import ReaderMatch, reported_progress
 from haptic_dob.recorder.recording import Recording
-from haptic_dob.recorder.settings import new_bag_path, recorder_specs
+from haptic_dob.recorder.settings import new_bag_path, progress_topic, recorder_specs
 from haptic_dob.recorder.snapshots import ParameterSnapshot, SnapshotTracker
 from haptic_dob.recorder.topics import TopicKind, parse_topics
 from haptic_dob.runtime.ros.params import ParameterTable
@@ -58,7 +58,6 @@ from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.raw import rclpy_type
 from haptic_msgs_py.stamps import NS_PER_S, period_ns
-from haptic_msgs_py.topics import RECORDER_PROGRESS
 
 PROGRESS_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
@@ -103,9 +102,10 @@ class RecorderNode(LoopNode):
             profile = SUBSCRIPTION_QOS[t.kind(resolved)]
             sub = self.create_subscription(classes[t.typename], t.name, cb, profile, raw=True)
             self._subs.append((sub, cb))
+        spaces = [n.rstrip("/") or "/" for n in v["namespaces"] if n] or [self.get_namespace()]
         self.snapshots: SnapshotTracker[Client] = SnapshotTracker(
             self.get_fully_qualified_name(),
-            self.get_namespace(),
+            spaces,
             v["snapshot_timeout_s"],
             lambda: ListParameters.Request(depth=0),
             lambda names: GetParameters.Request(names=names),
@@ -114,7 +114,9 @@ class RecorderNode(LoopNode):
         if self.recording.records_parameter_events:
             self.create_timer(DISCOVERY_S, self._on_discovery)
         self._progress_msg = Header(frame_id=self.get_fully_qualified_name())
-        self._progress = self.create_publisher(Header, RECORDER_PROGRESS, PROGRESS_QOS)
+        self._progress = [
+            self.create_publisher(Header, progress_topic(n), PROGRESS_QOS) for n in v["namespaces"]
+        ]
         self.create_timer(1.0 / v["progress_rate_hz"], self._publish_progress)
         self.get_logger().info(
             f"recording {len(topics)} topic(s) to {self.recording.path} ({self.recording.storage})"
@@ -143,7 +145,8 @@ class RecorderNode(LoopNode):
             return
         sec, nsec = divmod(self.reported_progress_ns(), NS_PER_S)
         self._progress_msg.stamp.sec, self._progress_msg.stamp.nanosec = sec, nsec
-        self._progress.publish(self._progress_msg)
+        for pub in self._progress:
+            pub.publish(self._progress_msg)
         self.recording.keep_durable()  # at least once a second: a kill -9 loses at most that
 
     # --- parameter snapshots ---------------------------------------------------------------

@@ -160,7 +160,9 @@ class DeviceNode(LoopNode):
         """What the start still waits for ('' when nothing)."""
         wait_for = self.params.values["wait_for"]
         ns = self.get_namespace()
-        names = {n for n, space in self.get_node_names_and_namespaces() if space == ns}
+        graph = self.get_node_names_and_namespaces()
+        names = {n for n, space in graph if space == ns}
+        names |= {f"{space.rstrip('/')}/{n}" for n, space in graph}  # /ns/node: anywhere
         missing = [w for w in wait_for if w not in names]
         if missing:
             return f"node{'s' if len(missing) > 1 else ''} {', '.join(missing)} in {ns}"
