@@ -35,6 +35,15 @@ def test_each_node_gets_its_sections_from_the_general_to_the_specific(sections, 
     assert params["slave/channel_node"]["channel.round_trip_delay_ms"] == 2.0
 
 
+def test_a_realtime_side_does_not_wait_for_its_peer_unless_told(sections) -> None:
+    assert "wait_for_peer" not in teleop_params(sections, [])["master/channel_node"]  # lockstep
+    params = teleop_params(sections, ["**/device_node:clock_mode=realtime"])
+    assert params["master/channel_node"]["wait_for_peer"] is False
+    assert params["slave/channel_node"]["wait_for_peer"] is False
+    sets = ["**/device_node:clock_mode=realtime", "slave/channel_node:wait_for_peer=true"]
+    assert teleop_params(sections, sets)["slave/channel_node"]["wait_for_peer"] is True
+
+
 def test_set_names_one_node_or_both_sides(sections) -> None:
     params = teleop_params(
         sections, ["**/device_node:duration_s=1.5", "slave/observer_node:kind=momentum"]

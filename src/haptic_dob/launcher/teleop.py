@@ -41,7 +41,9 @@ from haptic_dob.teleop.graph import (
 def teleop_params(
     sections: Mapping[str, Mapping[str, Any]], sets: Sequence[str]
 ) -> dict[str, dict[str, Any]]:
-    """``{"master/device_node": {param: value}, ...}`` for every node, ``--set`` applied."""
+    """``{"master/device_node": {param: value}, ...}`` for every node, ``--set`` applied; a side
+    whose device runs in real time gets ``wait_for_peer: false`` on its channel end unless given
+    (waiting for the peer's messages is lockstep's)."""
     try:
         check_sections(sections)
     except ValueError as exc:
@@ -64,6 +66,9 @@ def teleop_params(
             raise CliError(f"--set {item!r}: the value is not valid YAML") from None
         for name in names:
             out[name][param] = value
+    for ns in NAMESPACES:  # a real-time side's channel end uses what has come (no lockstep wait)
+        if out[f"{ns}/device_node"].get("clock_mode") == "realtime":
+            out[f"{ns}/channel_node"].setdefault("wait_for_peer", False)
     return out
 
 
