@@ -43,21 +43,37 @@ def lockstep_rtf(
         argv += ["--set", f"device_node:duration_s={MEASURE_S}"]
         argv += ["--set", f"controller_node:mode={mode}", "--set", "controller_node:kf=1.0"]
         argv += [a for s in sets for a in ("--set", s)]
-        # inside the test's own timeout, so a stuck probe says what it printed; SIGTERM lets
-        # haptic-launch stop the nodes it started (a SIGKILL would orphan them)
-        proc = subprocess.Popen(
-            argv, env=isolated_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-        )
-        try:
-            stdout, stderr = proc.communicate(timeout=PROBE_TIMEOUT_S)
-        except subprocess.TimeoutExpired:
-            proc.terminate()
-            stdout, stderr = proc.communicate(timeout=60)
-            pytest.fail(f"the capacity probe ran over {PROBE_TIMEOUT_S} s:\n{stderr[-2000:]}")
-        found = re.search(r"real-time factor ([0-9.]+)", stderr + stdout)
-        assert proc.returncode == 0 and found, stderr[-2000:]
-        _measured[key] = float(found.group(1))
+        _measured[key] = _probe(argv)
     return _measured[key]
+
+
+def teleop_lockstep_rtf() -> float:
+    """The lockstep real-time factor of the teleoperation graph (teleop_sim: both sides' nodes
+    composed in one process), the slower device's; measured once."""
+    key = (("teleop_sim",),)
+    if key not in _measured:
+        argv = [str(BIN / "haptic-launch"), str(ROOT / "config" / "teleop_sim.yaml")]
+        argv += ["--set", f"**/device_node:duration_s={MEASURE_S}"]
+        _measured[key] = _probe(argv)
+    return _measured[key]
+
+
+def _probe(argv: list[str]) -> float:
+    """Run a lockstep launch; the lowest real-time factor its devices report."""
+    # inside the test's own timeout, so a stuck probe says what it printed; SIGTERM lets
+    # haptic-launch stop the nodes it started (a SIGKILL would orphan them)
+    proc = subprocess.Popen(
+        argv, env=isolated_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    try:
+        stdout, stderr = proc.communicate(timeout=PROBE_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        proc.terminate()
+        stdout, stderr = proc.communicate(timeout=60)
+        pytest.fail(f"the capacity probe ran over {PROBE_TIMEOUT_S} s:\n{stderr[-2000:]}")
+    found = re.findall(r"real-time factor ([0-9.]+)", stderr + stdout)
+    assert proc.returncode == 0 and found, stderr[-2000:]
+    return min(float(f) for f in found)
 
 
 def require_realtime(
@@ -71,5 +87,18 @@ def require_realtime(
         pytest.skip(
             f"this machine turns the loop ({layout}; {mode}) over at {rtf:.2f}x real time in "
             f"lockstep, measured now; real time at 1 kHz needs {REQUIRED_RTF:g}x"
+        )
+    return rtf
+
+
+def require_realtime_teleop() -> float:
+    """Skip the calling test unless this machine turns the composed teleoperation graph over at
+    ``REQUIRED_RTF`` times real time or faster in lockstep (now); returns the figure."""
+    rtf = teleop_lockstep_rtf()
+    if rtf < REQUIRED_RTF:
+        pytest.skip(
+            f"this machine turns the teleoperation graph (both sides composed in one process) "
+            f"over at {rtf:.2f}x real time in lockstep, measured now; real time at 1 kHz needs "
+            f"{REQUIRED_RTF:g}x"
         )
     return rtf

@@ -9,12 +9,13 @@ import yaml
 from haptic_dob.cli import CliError
 from haptic_dob.launcher.options import LaunchOptions
 from haptic_dob.launcher.teleop import (
+    add_teleop_recorder,
     teleop_command,
     teleop_params,
     teleop_plan,
     write_teleop_params,
 )
-from haptic_dob.teleop.graph import load_teleop_sections
+from haptic_dob.teleop.graph import RECORDER, load_teleop_sections
 
 
 @pytest.fixture
@@ -32,6 +33,15 @@ def test_each_node_gets_its_sections_from_the_general_to_the_specific(sections, 
     assert slave["urdf_path"] == str(root / "config" / "urdf" / "arm7.urdf")  # beside the YAML
     assert params["master/channel_node"]["role"] == "master"
     assert params["slave/channel_node"]["channel.round_trip_delay_ms"] == 2.0
+
+
+def test_a_realtime_side_does_not_wait_for_its_peer_unless_told(sections) -> None:
+    assert "wait_for_peer" not in teleop_params(sections, [])["master/channel_node"]  # lockstep
+    params = teleop_params(sections, ["**/device_node:clock_mode=realtime"])
+    assert params["master/channel_node"]["wait_for_peer"] is False
+    assert params["slave/channel_node"]["wait_for_peer"] is False
+    sets = ["**/device_node:clock_mode=realtime", "slave/channel_node:wait_for_peer=true"]
+    assert teleop_params(sections, sets)["slave/channel_node"]["wait_for_peer"] is True
 
 
 def test_set_names_one_node_or_both_sides(sections) -> None:
@@ -61,12 +71,35 @@ def test_composed_by_default_one_process_each_with_processes(sections, tmp_path)
     assert dev.args[-4:] == ["-r", "__ns:=/slave", "-r", "__node:=device_node"]
 
 
+def test_record_adds_a_recorder_of_both_sides_apart_that_both_devices_wait_for(
+    sections, tmp_path
+) -> None:
+    params = teleop_params(sections, [])
+    add_teleop_recorder(params, str(tmp_path / "bag"), "mcap")
+    rec = params["recorder_node"]
+    assert rec["namespaces"] == ["/master", "/slave"] and rec["rate_hz"] == 1000.0
+    topics = [t.partition(":")[0] for t in rec["topics"]]
+    for name in ("/master/joint_states", "/slave/sim/hand_wrench", "/slave/pose_desired"):
+        assert name in topics
+    assert {"/teleop/to_slave", "/teleop/to_master", "/parameter_events"} <= set(topics)
+    for ns in ("master", "slave"):
+        assert params[f"{ns}/device_node"]["wait_for"][-1] == RECORDER
+    path = write_teleop_params(params, tmp_path)
+    assert "/recorder_node" in yaml.safe_load(path.read_text())
+    for processes in (False, True):
+        plan = teleop_plan(params, path, processes)
+        assert plan[0].nodes == ["recorder_node"]  # first, alone, in the root namespace
+        assert plan[0].executable.endswith("recorder_node") and "__ns:=" not in plan[0].args
+        assert all("recorder_node" not in s.nodes for s in plan[1:])
+    with pytest.raises(CliError, match="exists already"):
+        add_teleop_recorder(params, str(tmp_path), "mcap")
+
+
 @pytest.mark.parametrize(
     ("option", "flag"),
     [
         ({"namespace": "x"}, "--namespace"),
         ({"only": ("device_node",)}, "--only"),
-        ({"record": "bag"}, "--record"),
         ({"groups": ("a,b",)}, "--group"),
     ],
 )

@@ -13,6 +13,7 @@ from haptic_dob.recorder.settings import (
     LOG_TIMES,
     STORAGES,
     new_bag_path,
+    progress_topic,
     recorder_specs,
 )
 
@@ -24,6 +25,7 @@ def test_parameters() -> None:
         "storage",
         "log_time",
         "topics",
+        "namespaces",
         "duration_s",
         "rate_hz",
         "progress_rate_hz",
@@ -34,6 +36,12 @@ def test_parameters() -> None:
     assert specs["log_time"].choices == LOG_TIMES and specs["log_time"].default == "session"
     assert specs["topics"].default == DEFAULT_TOPICS and specs["topics"].length is None
     assert [n for n, s in specs.items() if not s.read_only] == ["rate_hz"]
+    assert specs["namespaces"].default == [""]  # its own
+
+
+def test_progress_goes_to_the_own_namespace_or_each_given_one() -> None:
+    assert progress_topic("") == "recorder/progress"  # relative: the recorder's namespace
+    assert progress_topic("/master") == progress_topic("/master/") == "/master/recorder/progress"
 
 
 def test_every_storage_opens(tmp_path: Path) -> None:

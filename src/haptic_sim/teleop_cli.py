@@ -26,7 +26,7 @@ from haptic_dob.configs import resolve_config
 from haptic_dob.observer import OBSERVER_KINDS
 from haptic_dob.teleop.settings import ARCHITECTURES, FORCE_SOURCES
 from haptic_sim.teleop_config import TeleopConfig
-from haptic_sim.teleop_result import TeleopMetrics
+from haptic_sim.teleop_result import TeleopMetrics, TeleopResult
 from haptic_sim.teleop_session import run_teleop
 from haptic_sim.teleop_stability import DelayPoint, DelayProtocol, boundary_ms, delay_sweep
 
@@ -121,10 +121,74 @@ def format_sweep(points: list[DelayPoint], threshold_mm: float) -> str:
     return "\n".join(lines)
 
 
+#: options that configure a run: not for ``--bag`` (the bag says how its session ran)
+RUN_OPTIONS = {
+    "config": "CONFIG",
+    "architecture": "--architecture",
+    "force_source": "--force-source",
+    "delay_ms": "--delay-ms",
+    "jitter_ms": "--jitter-ms",
+    "passivity": "--passivity",
+    "observer": "--observer",
+    "duration": "--duration",
+    "set": "--set",
+    "sweep": "--sweep",
+}
+
+
+def bag_command(args: Any) -> int:
+    """``--bag``: the figures (and ``--out``: the force-tracking figure) of a recorded graph."""
+    from haptic_sim.teleop_bag import read_teleop_bag
+
+    given = [flag for name, flag in RUN_OPTIONS.items() if getattr(args, name) not in (None, [])]
+    if given:
+        raise CliError(
+            f"{', '.join(given)}: not with --bag (the bag's parameters say how its session ran)"
+        )
+    out = Path(args.out) if args.out else None
+    session = read_teleop_bag(args.bag)
+    if session.samples_missing:
+        print(
+            f"note: {session.samples_missing} sample(s) missing on some topic, left out",
+            file=sys.stderr,
+        )
+    return report(session.result.metrics(), [], session.result if out else None, out, args.json)
+
+
+def report(
+    metrics: TeleopMetrics,
+    points: list[DelayPoint],
+    result: TeleopResult | None,
+    out: Path | None,
+    as_json: bool,
+) -> int:
+    """Print the figures (and the sweep's); write the force-tracking figure of ``result``."""
+    if out is not None and result is not None:
+        from haptic_sim.teleop_figures import plot_force_tracking
+
+        out.mkdir(parents=True, exist_ok=True)
+        plot_force_tracking(result, out / "force_tracking.png")
+    if as_json:
+        doc: dict[str, Any] = dataclasses.asdict(metrics)
+        if points:
+            doc["sweep"] = [dataclasses.asdict(p) for p in points]
+        print(json.dumps(_no_nan(doc), allow_nan=False))
+    else:
+        print(format_metrics(metrics))
+        if points:
+            print()
+            print(format_sweep(points, DelayProtocol().threshold_mm))
+    if out is not None:
+        print(f"figures in {out}", file=sys.stderr)
+    return 0
+
+
 def command(args: Any) -> int:
     """Run what ``args`` ask for; raises on bad input."""
+    if args.bag:
+        return bag_command(args)
     cfg = configure(
-        args.config,
+        args.config or "teleop_sim",
         args.set,
         args.architecture,
         args.force_source,
@@ -139,11 +203,6 @@ def command(args: Any) -> int:
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
     result = run_teleop(cfg)
-    metrics = result.metrics()
-    if out is not None:
-        from haptic_sim.teleop_figures import plot_force_tracking
-
-        plot_force_tracking(result, out / "force_tracking.png")
     points: list[DelayPoint] = []
     protocol = DelayProtocol()
     if delays is not None:
@@ -152,19 +211,7 @@ def command(args: Any) -> int:
             from haptic_sim.teleop_figures import plot_delay_sweep
 
             plot_delay_sweep(points, protocol.threshold_mm, out / "stability.png")
-    if args.json:
-        doc: dict[str, Any] = dataclasses.asdict(metrics)
-        if points:
-            doc["sweep"] = [dataclasses.asdict(p) for p in points]
-        print(json.dumps(_no_nan(doc), allow_nan=False))
-    else:
-        print(format_metrics(metrics))
-        if points:
-            print()
-            print(format_sweep(points, protocol.threshold_mm))
-    if out is not None:
-        print(f"figures in {out}", file=sys.stderr)
-    return 0
+    return report(result.metrics(), points, result, out, args.json)
 
 
 def _no_nan(value: Any) -> Any:
@@ -181,8 +228,12 @@ def _no_nan(value: Any) -> Any:
 def build_parser() -> ArgumentParser:
     """The command line of ``haptic-teleop``."""
     p = ArgumentParser(prog="haptic-teleop", description=__doc__.split("\n\n")[0])
+    p.add_argument("config", nargs="?", help="teleoperation YAML (default teleop_sim)")
     p.add_argument(
-        "config", nargs="?", default="teleop_sim", help="teleoperation YAML (default teleop_sim)"
+        "--bag",
+        metavar="BAG",
+        help="analyse a recorded teleoperation graph (haptic-launch teleop_sim --record BAG) "
+        "instead of running one: its figures, and with --out its force-tracking figure",
     )
     p.add_argument("--architecture", choices=ARCHITECTURES, help="what the master renders")
     p.add_argument(

@@ -9,7 +9,8 @@ Contact means the true contact force is non-zero. Figures during contact:
   slave (``R F_w / force_scale``) at the same instant: the delay and the master's limits count.
 
 Outside contact: ``free_estimate_max_n``, the largest estimate while nothing touches (after
-``settle_s``), and ``position_error_mm``, the RMS distance from the slave's tool point to the
+``settle_s``), and ``position_error_mm``, the RMS distance from the slave's tool point (from its
+encoders: what the slave's ``ee_pose`` says) to the
 master's point mapped to the slave. Channel: ``channel_energy_min_j``, the lowest net energy
 the channel took in (``E_in`` minus ``E_out`` of both ports; below zero it has generated energy),
 ``dissipated_j`` what the passivity controllers took out, and ``oscillation_mm``, the standard
@@ -20,6 +21,7 @@ axis (a loop that vibrates; the hand's own motion lies below).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -61,10 +63,11 @@ class TeleopMetrics:
 class TeleopResult:
     """Per-cycle arrays (SI units), one row per cycle k; 3-vectors in the slave's frame.
 
-    ``master_point``: the master's point mapped to the slave; ``slave_point``: the slave's true
-    tool point; ``target``: the point the slave tracks; ``contact``: the true contact force;
-    ``estimate``: the slave observer's; ``sensor``: the wrist sensor's; ``rendered``: the master's
-    wall force scaled to the slave; ``hand``: the hand's force on the master (its frame);
+    ``master_point``: the master's point mapped to the slave (``mapped_point``);
+    ``slave_point``: the slave's tool point from its encoders (its ``ee_pose``); ``target``: the
+    point the slave tracks; ``contact``: the true contact force; ``estimate``: the slave
+    observer's; ``sensor``: the wrist sensor's; ``rendered``: the master's wall force scaled to
+    the slave (``rendered_force``); ``hand``: the hand's force on the master (its frame);
     ``e_in_*``/``e_out_*``: each port's energy book (J); ``dissipated``: both controllers'
     (J); ``silent``: 1 the master's end lost the slave, 2 the slave's end the master, 3 both.
     """
@@ -146,6 +149,24 @@ class TeleopResult:
             f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "config"
         }
         np.savez(path, **arrays)
+
+
+def mapped_point(
+    R: np.ndarray, scale: float, p_s0: np.ndarray, p_m0: np.ndarray, p: Sequence[float]
+) -> np.ndarray:
+    """The master's point ``p`` (m, its frame) mapped to the slave: ``p_s0 + scale R (p -
+    p_m0)``, the start points ``p_m0`` and ``p_s0`` of master and slave."""
+    out: np.ndarray = p_s0 + scale * (R @ (np.asarray(p) - p_m0))
+    return out
+
+
+def rendered_force(R: np.ndarray, force_scale: float, f_w: Sequence[float]) -> np.ndarray:
+    """The master's wall force ``f_w`` (N, its frame) in slave units: ``R f_w / force_scale``
+    (zero for a zero scale)."""
+    if force_scale <= 0.0:
+        return np.zeros(3)
+    out: np.ndarray = (R @ np.asarray(f_w)) / force_scale
+    return out
 
 
 def _rms(x: np.ndarray) -> float:

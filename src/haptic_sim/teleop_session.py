@@ -24,12 +24,12 @@ from haptic_dob.models.slide import SlideModel
 from haptic_dob.teleop.ends import MasterEnd, SlaveEnd
 from haptic_dob.teleop.slave import SlaveController
 from haptic_sim.teleop_config import TeleopConfig
-from haptic_sim.teleop_result import TeleopResult
+from haptic_sim.teleop_result import TeleopResult, mapped_point, rendered_force
 
 #: per-cycle 3-vectors recorded (slave frame unless said)
 CART = (
     "master_point",  # the master's point mapped to the slave: start + scale R d_m (m)
-    "slave_point",  # the slave's true tool point (m)
+    "slave_point",  # the slave's tool point, from its encoders (m)
     "target",  # the point the slave tracks (m)
     "contact",  # the true contact force on the slave (N)
     "estimate",  # the slave observer's estimate (N)
@@ -87,13 +87,13 @@ def run_teleop(config: TeleopConfig, cycles: int | None = None) -> TeleopResult:
         s_end.receive(to_slave)
         m_end.receive(to_master)
         # the record
-        cart["master_point"][k] = p_s0 + sp * (R @ (np.asarray(sm.ee_position) - p_m0))
-        cart["slave_point"][k] = slave.model._forward_kinematics(slave.q)
+        cart["master_point"][k] = mapped_point(R, sp, p_s0, p_m0, sm.ee_position)
+        cart["slave_point"][k] = ss.ee_position
         cart["target"][k] = target
         cart["contact"][k] = slave.contact_force_true
         cart["estimate"][k] = f_hat
         cart["sensor"][k] = ss.wrench_measured
-        cart["rendered"][k] = (R @ np.asarray(f_w)) / sf if sf > 0.0 else 0.0
+        cart["rendered"][k] = rendered_force(R, sf, f_w)
         cart["hand"][k] = sm.hand_force
         mp, sp_ = m_end.port, s_end.port
         scal["e_in_master"][k], scal["e_out_master"][k] = mp.e_in, mp.e_out

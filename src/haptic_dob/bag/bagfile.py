@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from haptic_dob.bag.errors import BagError
+from haptic_dob.teleop.graph import TO_SLAVE
 
 _MCAP_MAGIC = b"\x89MCAP0\r\n"
 _SQLITE_MAGIC = b"SQLite format 3\x00"
@@ -102,8 +103,10 @@ def resolve_topic(topics: dict[str, str], name: str, what: str, shown: str) -> s
     if not found:
         raise BagError(f"{shown} has no {what} topic {name!r}; topics: {listing(topics)}")
     if len(found) > 1:
+        teleop = TO_SLAVE in topics  # both sides' topics: a teleoperation graph's recording
         raise BagError(
             f"{shown} has several {what} topics named {name!r} ({', '.join(found)}); "
             "give the full name"
+            + (f" (a recorded teleoperation graph: haptic-teleop --bag {shown})" if teleop else "")
         )
     return found[0]

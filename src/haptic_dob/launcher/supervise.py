@@ -1,6 +1,7 @@
 """The launch's processes at run time: the scheduling and wake-up latency they start with, then
-start, watch (a failed node or the device's finished run stops the graph), forward Ctrl-C and
-SIGTERM, and stop them all (the device's first), killing what outlives the stop timeout."""
+start, watch (a failed node stops the graph, and so does the end of the run once every device
+finished its own), forward Ctrl-C and SIGTERM, and stop them all (the device's first), killing
+what outlives the stop timeout."""
 
 from __future__ import annotations
 
@@ -76,19 +77,20 @@ def launch(
         t_end = None if duration is None else time.monotonic() + duration
         while not stop:
             done = {n: p.returncode for n, p in procs.items() if p.poll() is not None}
-            if done:
-                name, rc = next(iter(done.items()))
-                if name in devices and rc == 0:
-                    print(
-                        "haptic-launch: device_node finished its run; stopping the graph",
-                        file=sys.stderr,
-                    )
-                else:
-                    print(
-                        f"ERROR: {labels[name]} exited with code {rc}; stopping the graph",
-                        file=sys.stderr,
-                    )
-                    code = 1
+            failed = [(n, rc) for n, rc in done.items() if n not in devices or rc != 0]
+            if failed:
+                name, rc = failed[0]
+                print(
+                    f"ERROR: {labels[name]} exited with code {rc}; stopping the graph",
+                    file=sys.stderr,
+                )
+                code = 1
+                break
+            if done and devices <= set(done):  # every device finished its run (a teleop: two)
+                print(
+                    "haptic-launch: device_node finished its run; stopping the graph",
+                    file=sys.stderr,
+                )
                 break
             if t_end is not None and time.monotonic() >= t_end:
                 break

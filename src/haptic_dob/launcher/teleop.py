@@ -5,8 +5,11 @@ A YAML with ``/master/...`` or ``/slave/...`` sections is a teleoperation graph:
 parameters are its sections overlaid (``node_values``), written to a params file under the
 node's full name; ``--set NS/NODE:PARAM=VALUE`` overrides one node's, ``**/NODE:`` the node of
 both sides. ``--composed`` (the default) runs all nodes in one container (their messages handed
-over in process), ``--processes`` one process each; the options of a single loop's launch
-(``--namespace``, ``--group``, ``--only``, ``--record``, ``--pin``, ``--cpu-latency``) are refused.
+over in process), ``--processes`` one process each. ``--record BAG`` adds a ``recorder_node`` in
+the root namespace, in a process of its own: it records both sides' topics and the channel's
+(``recorded_topics``), snapshots the nodes of ``/master`` and ``/slave``, and both devices wait
+for it (``haptic-teleop --bag BAG`` analyses the bag). The options of a single loop's launch
+(``--namespace``, ``--group``, ``--only``, ``--pin``, ``--cpu-latency``) are refused.
 """
 
 from __future__ import annotations
@@ -24,13 +27,23 @@ from haptic_dob.launcher.options import LaunchOptions, network_env
 from haptic_dob.launcher.process_plan import ProcessSpec, executable
 from haptic_dob.launcher.supervise import launch, set_rt_priority
 from haptic_dob.nodes.registry import CONTAINER, NODES
-from haptic_dob.teleop.graph import NAMESPACES, check_sections, graph_nodes, node_values
+from haptic_dob.teleop.graph import (
+    NAMESPACES,
+    RECORDER,
+    SIDE_NODES,
+    check_sections,
+    graph_nodes,
+    node_values,
+    recorded_topics,
+)
 
 
 def teleop_params(
     sections: Mapping[str, Mapping[str, Any]], sets: Sequence[str]
 ) -> dict[str, dict[str, Any]]:
-    """``{"master/device_node": {param: value}, ...}`` for every node, ``--set`` applied."""
+    """``{"master/device_node": {param: value}, ...}`` for every node, ``--set`` applied; a side
+    whose device runs in real time gets ``wait_for_peer: false`` on its channel end unless given
+    (waiting for the peer's messages is lockstep's)."""
     try:
         check_sections(sections)
     except ValueError as exc:
@@ -53,6 +66,9 @@ def teleop_params(
             raise CliError(f"--set {item!r}: the value is not valid YAML") from None
         for name in names:
             out[name][param] = value
+    for ns in NAMESPACES:  # a real-time side's channel end uses what has come (no lockstep wait)
+        if out[f"{ns}/device_node"].get("clock_mode") == "realtime":
+            out[f"{ns}/channel_node"].setdefault("wait_for_peer", False)
     return out
 
 
@@ -71,13 +87,34 @@ def write_teleop_params(params: Mapping[str, Mapping[str, Any]], directory: Path
     return path
 
 
+def add_teleop_recorder(params: dict[str, dict[str, Any]], output: str, storage: str) -> None:
+    """``--record``: a recorder of both sides (``RECORDER``), and both devices waiting for it."""
+    if Path(output).exists():
+        raise CliError(f"--record {output}: it exists already; the recorder never overwrites a bag")
+    params[RECORDER.lstrip("/")] = {
+        "output": output,
+        "storage": storage,
+        "topics": recorded_topics(),
+        "namespaces": [f"/{ns}" for ns in NAMESPACES],
+        "rate_hz": params["master/device_node"].get("rate_hz", 1000.0),
+    }
+    for ns in NAMESPACES:
+        device = params[f"{ns}/device_node"]
+        default = [n for n in SIDE_NODES[ns] if n != "device_node"]
+        device["wait_for"] = [*device.get("wait_for", default), RECORDER]
+
+
 def teleop_plan(params: Mapping[str, Any], params_file: Path, processes: bool) -> list[ProcessSpec]:
-    """One container for every node, or (``processes``) a process per node, devices last."""
+    """One container for every node, or (``processes``) a process per node, devices last; a
+    recorder (in the root namespace) in a process of its own, first."""
     ros = ["--ros-args", "--params-file", str(params_file)]
-    names = list(params)
-    if not processes:
-        return [ProcessSpec(", ".join(names), names, executable(*CONTAINER), [*names, *ros])]
     out = []
+    names = [n for n in params if "/" in n]
+    for name in (n for n in params if "/" not in n):
+        entry = NODES[name]
+        out.append(ProcessSpec(name, [name], executable(entry.package, entry.executable), ros))
+    if not processes:
+        return [*out, ProcessSpec(", ".join(names), names, executable(*CONTAINER), [*names, *ros])]
     for name in names:
         ns, _, node = name.partition("/")
         entry = NODES[node]
@@ -90,7 +127,6 @@ REFUSED = {
     "namespace": "--namespace",
     "groups": "--group",
     "only": "--only",
-    "record": "--record",
     "pin": "--pin",
     "cpu_latency_us": "--cpu-latency",
 }
@@ -107,6 +143,8 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
     if opts.composed and opts.processes:
         raise CliError("--composed and --processes are different choices: pick one")
     params = teleop_params(sections, opts.sets)
+    if opts.record:
+        add_teleop_recorder(params, opts.record, opts.record_storage)
     net = network_env(opts.network, opts.peers)
     if opts.rt_priority is not None:
         set_rt_priority(opts.rt_priority)
@@ -114,6 +152,7 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
         net["HAPTIC_DOB_EXECUTOR"] = opts.executor
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
         specs = teleop_plan(params, write_teleop_params(params, Path(tmp)), opts.processes)
-        if len(specs) == 1:
-            print(f"haptic-launch: {specs[0].name} in one process", file=sys.stderr)
+        for spec in specs:
+            if len(spec.nodes) > 1:
+                print(f"haptic-launch: {spec.name} in one process", file=sys.stderr)
         return launch(specs, opts.stop_timeout, opts.duration, net)

@@ -46,13 +46,20 @@ from haptic_msgs_py.topics import (
 from haptic_msgs_py.values import JointSample, StampedVector
 
 ROLES = ("master", "slave")
-PORT_NAMES = ("x", "y", "z", "energy")
+PORT_NAMES = ("x", "y", "z", "energy", "silent")
 
 
 def to_wire(m: PortMessage) -> JointSample:
-    """A port message as a JointState: x, y, z and the energy in its fourth place."""
+    """A port message as a JointState: the point, velocity and force as joints x, y, z; the
+    energy book as joint ``energy`` (position E_in, velocity E_out, effort dissipated, J); and
+    ``silent`` (position 1.0 when the sender found its peer silent)."""
+    s = 1.0 if m.peer_silent else 0.0
     return JointSample(
-        m.stamp_ns, PORT_NAMES, (*m.position, m.energy_in_j), (*m.velocity, 0.0), (*m.force, 0.0)
+        m.stamp_ns,
+        PORT_NAMES,
+        (*m.position, m.energy_in_j, s),
+        (*m.velocity, m.energy_out_j, 0.0),
+        (*m.force, m.dissipated_j, 0.0),
     )
 
 
@@ -60,7 +67,14 @@ def from_wire(js: JointSample) -> PortMessage:
     """The port message a JointState of ``to_wire`` carries."""
     p, v, f = js.position, js.velocity, js.effort
     return PortMessage(
-        js.stamp_ns, (p[0], p[1], p[2]), (v[0], v[1], v[2]), (f[0], f[1], f[2]), p[3]
+        js.stamp_ns,
+        (p[0], p[1], p[2]),
+        (v[0], v[1], v[2]),
+        (f[0], f[1], f[2]),
+        p[3],
+        v[3],
+        f[3],
+        p[4] != 0.0,
     )
 
 

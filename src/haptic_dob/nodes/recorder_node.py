@@ -5,16 +5,20 @@
   publishers' last 2000 samples), the parameter-events profile for ``/parameter_events``,
   reliable volatile for other topics. Bag time: the session's (``log_time``, as ``ros2 bag
   record --use-sim-time``; ``/clock`` is read where no loop topic is recorded) or receive time.
-- Writes a snapshot of every node in its namespace (``list_parameters`` + ``get_parameters``,
-  when it appears; one silent for ``snapshot_timeout_s`` is warned about and still asked) as a
-  ``ParameterEvent`` with all parameters in ``new_parameters`` on ``/parameter_events``, so the
-  bag says which stiffness, mode and gains were active at every moment.
-- Publishes ``recorder/progress`` (``std_msgs/Header``: the newest stamp written, minimum over
-  the stamped topics flowing; its name in ``frame_id``) at ``progress_rate_hz``: a lockstep
-  device holds the loop while that lags, so a recorded lockstep run loses nothing. The report is
-  held where a node appeared until its parameters came (at most ``snapshot_timeout_s``). Before
-  the first loop sample it is ``PROGRESS_NOT_MATCHED_NS`` while a reader has not matched its
-  writers (``haptic_dob.recorder.matching``): the device sends sample 0 only after that.
+- Writes a snapshot of every node in its ``namespaces`` (default its own; ``list_parameters`` +
+  ``get_parameters``; a node silent for ``snapshot_timeout_s`` is warned about and still asked) as a
+  ``rcl_interfaces/msg/ParameterEvent`` with all parameters in ``new_parameters``, on
+  ``/parameter_events`` beside the live events, so the bag says which stiffness, mode and gains
+  were active at every moment. Nodes that start later are snapshot when they appear.
+- Publishes ``recorder/progress`` in each of them (``std_msgs/Header``: the stamp, and its name in
+  ``frame_id`` so a device can follow the slowest of several; reliable, transient local) at
+  ``progress_rate_hz``: the newest stamp written, minimum over the stamped topics that are
+  flowing (header stamps; the effort command's ``effort@<stamp>`` label). A lockstep device
+  holds the loop while that lags, so a recorded lockstep run loses nothing. The report is held
+  where a node appeared until its parameters came (at most ``snapshot_timeout_s``), so a short
+  lockstep run cannot end before the bag knows the session's parameters. Before the first loop
+  sample it reports ``PROGRESS_NOT_MATCHED_NS`` while a reader has not matched its writers
+  (``haptic_dob.recorder.matching``): the device sends sample 0 only after that.
 - On SIGINT/SIGTERM (or after ``duration_s``) it takes what is still queued (at most
   ``drain_timeout_s``, until nothing arrives for 0.1 s), then closes the bag so it is readable,
   and reports per topic what it received, wrote and which stamps are missing (gaps).
@@ -47,7 +51,7 @@ from haptic_dob.nodes.common import main_for
 from haptic_dob.recorder.drain import take_until_quiet
 from haptic_dob.recorder.matching import ReaderMatch, reported_progress
 from haptic_dob.recorder.recording import Recording
-from haptic_dob.recorder.settings import new_bag_path, recorder_specs
+from haptic_dob.recorder.settings import new_bag_path, progress_topic, recorder_specs
 from haptic_dob.recorder.snapshots import ParameterSnapshot, SnapshotTracker
 from haptic_dob.recorder.topics import TopicKind, parse_topics
 from haptic_dob.runtime.ros.params import ParameterTable
@@ -55,7 +59,7 @@ from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.raw import rclpy_type
 from haptic_msgs_py.stamps import NS_PER_S, period_ns
-from haptic_msgs_py.topics import CLOCK, RECORDER_PROGRESS
+from haptic_msgs_py.topics import CLOCK
 
 PROGRESS_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
@@ -105,9 +109,10 @@ class RecorderNode(LoopNode):
             self._subs.append((sub, cb))
         if v["log_time"] == "session" and TopicKind.SESSION not in kinds:  # no loop stamps
             self.create_subscription(Clock, CLOCK, self._on_clock, qos.CLOCK)
+        spaces = [n.rstrip("/") or "/" for n in v["namespaces"] if n] or [self.get_namespace()]
         self.snapshots: SnapshotTracker[Client] = SnapshotTracker(
             self.get_fully_qualified_name(),
-            self.get_namespace(),
+            spaces,
             v["snapshot_timeout_s"],
             lambda: ListParameters.Request(depth=0),
             lambda names: GetParameters.Request(names=names),
@@ -116,7 +121,9 @@ class RecorderNode(LoopNode):
         if self.recording.records_parameter_events:
             self.create_timer(DISCOVERY_S, self._on_discovery)
         self._progress_msg = Header(frame_id=self.get_fully_qualified_name())
-        self._progress = self.create_publisher(Header, RECORDER_PROGRESS, PROGRESS_QOS)
+        self._progress = [
+            self.create_publisher(Header, progress_topic(n), PROGRESS_QOS) for n in v["namespaces"]
+        ]
         self.create_timer(1.0 / v["progress_rate_hz"], self._publish_progress)
         self.get_logger().info(
             f"recording {len(topics)} topic(s) to {self.recording.path} ({self.recording.storage})"
@@ -145,7 +152,8 @@ class RecorderNode(LoopNode):
             return
         sec, nsec = divmod(self.reported_progress_ns(), NS_PER_S)
         self._progress_msg.stamp.sec, self._progress_msg.stamp.nanosec = sec, nsec
-        self._progress.publish(self._progress_msg)
+        for pub in self._progress:
+            pub.publish(self._progress_msg)
         self.recording.keep_durable()  # at least once a second: a kill -9 loses at most that
 
     def _on_clock(self, msg: Clock) -> None:

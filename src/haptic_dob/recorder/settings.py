@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 from haptic_dob.runtime.params import ParamSpec
-from haptic_msgs_py.topics import PARAMETER_EVENTS, SESSION_TOPICS
+from haptic_msgs_py.topics import PARAMETER_EVENTS, RECORDER_PROGRESS, SESSION_TOPICS
 
 STORAGES = ("mcap", "sqlite3")  # bag storages (``haptic_dob.bag.write.open_writer``)
 LOG_TIMES = ("session", "receive")  # a message's bag time (``haptic_dob.recorder.recording``)
@@ -40,6 +40,13 @@ def recorder_specs() -> list[ParamSpec]:
             list(DEFAULT_TOPICS),
             "topics to record: session topics and /parameter_events by name, others as "
             "NAME:pkg/msg/Type",
+            read_only=True,
+        ),
+        ParamSpec(
+            "namespaces",
+            [""],
+            "namespaces whose nodes it snapshots and whose devices it reports its progress to "
+            "(<ns>/recorder/progress); [''] = its own (a teleoperation graph: [/master, /slave])",
             read_only=True,
         ),
         ParamSpec(
@@ -92,3 +99,8 @@ def new_bag_path(output: str) -> Path:
     if path.exists():
         raise ValueError(f"{path} exists already; the recorder never overwrites a bag")
     return path
+
+
+def progress_topic(namespace: str) -> str:
+    """Where the devices of ``namespace`` ('' = the recorder's own) read its progress."""
+    return f"{namespace.rstrip('/')}/{RECORDER_PROGRESS}" if namespace else RECORDER_PROGRESS

@@ -1,6 +1,7 @@
 """Parameter snapshots: which nodes the recorder asks for their parameters, and how far each is.
 
-Every node of the recorder's namespace (except hidden ones and the recorder) is asked once,
+Every node of the recorder's namespaces (its own, or those it is given: a teleoperation graph's
+``/master`` and ``/slave``; not hidden ones nor the recorder) is asked once,
 when it appears: ``list_parameters``, then ``get_parameters`` of every name. A node silent for
 the timeout is reported once and still asked (a loaded node answers late, and a client dropped
 under a pending request makes the node's own executor fail to send its response). Until a node
@@ -10,7 +11,7 @@ a short lockstep run cannot end before the bag knows the session's parameters.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Generic, Protocol, TypeVar
 
@@ -62,7 +63,8 @@ class SnapshotRound(Generic[C]):
 
 
 class SnapshotTracker(Generic[C]):
-    """The nodes of ``namespace`` whose parameters the recorder ``own_name`` asks for.
+    """The nodes of ``namespaces`` (one, or several) whose parameters the recorder ``own_name``
+    asks for.
 
     ``list_request()`` and ``get_request(names)`` make the two service requests.
     """
@@ -70,12 +72,12 @@ class SnapshotTracker(Generic[C]):
     def __init__(
         self,
         own_name: str,
-        namespace: str,
+        namespaces: str | Sequence[str],
         timeout_s: float,
         list_request: Callable[[], Any],
         get_request: Callable[[list[str]], Any],
     ) -> None:
-        self.namespace = namespace
+        self.namespaces = (namespaces,) if isinstance(namespaces, str) else tuple(namespaces)
         self.timeout_s = timeout_s
         self.pending: list[PendingSnapshot[C]] = []
         self._known = {own_name}
@@ -83,11 +85,11 @@ class SnapshotTracker(Generic[C]):
         self._get_request = get_request
 
     def appeared(self, names_and_namespaces: Iterable[tuple[str, str]]) -> list[str]:
-        """Fully qualified names of the nodes of the namespace not seen before (not hidden)."""
+        """Fully qualified names of the nodes of the namespaces not seen before (not hidden)."""
         new = []
         for name, space in names_and_namespaces:
             full = f"{space.rstrip('/')}/{name}"
-            if space != self.namespace or name.startswith("_") or full in self._known:
+            if space not in self.namespaces or name.startswith("_") or full in self._known:
                 continue
             self._known.add(full)
             new.append(full)

@@ -37,13 +37,20 @@ Vec3 = tuple[float, float, float]
 
 class PortMessage(NamedTuple):
     """One side's port at sample ``stamp_ns`` (slave units): displacement from the side's start
-    point (m), velocity (m/s), force (N) and the energy that came into the channel there (J)."""
+    point (m), velocity (m/s), force (N) and the energy that came into the channel there (J).
+
+    For the record only (the peer does not use them): the energy the channel gave out there
+    (J), what the side's passivity controller took out (J), and whether the side found its
+    peer silent this sample."""
 
     stamp_ns: int
     position: Vec3
     velocity: Vec3
     force: Vec3
     energy_in_j: float
+    energy_out_j: float = 0.0
+    dissipated_j: float = 0.0
+    peer_silent: bool = False
 
 
 def _rotate(R: tuple[Vec3, Vec3, Vec3], s: float, v: Vec3) -> Vec3:
@@ -97,6 +104,13 @@ class _End:
             self.port.received(msg.energy_in_j)
         self.peer_silent = self.line.silent(k)
         return None if self.peer_silent else msg
+
+    def _message(self, stamp_ns: int, position: Vec3, velocity: Vec3, force: Vec3) -> PortMessage:
+        """This sample's message, with the port's energy book as it stands."""
+        p = self.port
+        return PortMessage(
+            stamp_ns, position, velocity, force, p.e_in, p.e_out, p.dissipated_j, self.peer_silent
+        )
 
 
 class MasterEnd(_End):
@@ -170,7 +184,7 @@ class MasterEnd(_End):
         if a is not None:
             s = fw[0] * a[0] + fw[1] * a[1] + fw[2] * a[2]
             fw = (s * a[0], s * a[1], s * a[2])
-        return fw, PortMessage(stamp_ns, x, v, f, self.port.e_in)
+        return fw, self._message(stamp_ns, x, v, f)
 
 
 class SlaveEnd(_End):
@@ -219,4 +233,4 @@ class SlaveEnd(_End):
             self._disp = d
         o = self.origin
         disp = (position[0] - o[0], position[1] - o[1], position[2] - o[2])
-        return self.target, PortMessage(stamp_ns, disp, velocity, force, self.port.e_in)
+        return self.target, self._message(stamp_ns, disp, velocity, force)

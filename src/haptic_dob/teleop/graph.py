@@ -25,6 +25,33 @@ SIDE_NODES = {
 #: the channel's link between the ends (absolute: it joins the two namespaces)
 TO_SLAVE = "/teleop/to_slave"
 TO_MASTER = "/teleop/to_master"
+#: the recorder of a teleoperation graph (root namespace: it records both sides)
+RECORDER = "/recorder_node"
+_JOINT_STATE = "sensor_msgs/msg/JointState"
+_POSE = "geometry_msgs/msg/PoseStamped"
+
+
+def recorded_topics() -> list[str]:
+    """What a teleoperation graph's recorder records (``NAME:pkg/msg/Type``): every session
+    topic of both sides (but the slave's ``wrench_desired``: it has no wall), the slave's
+    ``pose_desired``, the channel's link both ways and the parameter events (each node's
+    parameters)."""
+    from haptic_msgs_py.topics import (
+        PARAMETER_EVENTS,
+        POSE_DESIRED,
+        SESSION_TOPICS,
+        WRENCH_DESIRED,
+    )
+
+    out = [
+        f"/{ns}/{topic}:{kind}"
+        for ns in NAMESPACES
+        for topic, kind in SESSION_TOPICS.items()
+        if not (ns == "slave" and topic == WRENCH_DESIRED)  # the slave has no wall
+    ]
+    out += [f"/slave/{POSE_DESIRED}:{_POSE}", f"{TO_SLAVE}:{_JOINT_STATE}"]
+    out += [f"{TO_MASTER}:{_JOINT_STATE}", PARAMETER_EVENTS]
+    return out
 
 
 def node_values(sections: Mapping[str, Mapping[str, Any]], ns: str, node: str) -> dict[str, Any]:

@@ -82,6 +82,7 @@ class DeviceNode(LoopNode):
         cycles = round(v["duration_s"] * v["rate_hz"])
         last_k = cycles if cycles > 0 else None  # the run ends after publishing sample N
         self.loop = DeviceLoop(self.device, self, self.get_logger(), v, self.lockstep, last_k)
+        self.finishes_run = last_k is not None  # a process of two devices waits for both
         self.params.set_validator(self.loop.settings_for, self._apply)
         base = v["base_frame"]
         self._names = tuple(self.device.model.joint_names)

@@ -12,6 +12,10 @@ a few samples behind when the device finishes; in real time new samples keep com
 process waits until its reliable readers acknowledged what it published (a recorder or a slow
 reader may still be repairing a lost sample), all within ``DRAIN_BUDGET_S``. A device node has no
 marker: it zeroes its effort at once.
+
+A process stops when a node finishes (a device at the end of its ``duration_s``), once every node
+of it that ends its run by itself (``finishes_run``) has: two devices composed (a teleoperation
+graph's master and slave) both finish their runs, although one may reach its end first.
 """
 
 from __future__ import annotations
@@ -73,6 +77,7 @@ class LoopNode(Node):
 
     finished: bool = False
     exit_code: int = 0
+    finishes_run: bool = False  # it ends its run by itself: the process waits for it to finish
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -149,6 +154,17 @@ def hold_asked_cpu_latency(nodes: Sequence[Node]) -> int | None:
     return fd
 
 
+def run_over(nodes: Sequence[LoopNode]) -> bool:
+    """Whether the spin loop stops: a node finished with an error or without ending a run of its
+    own, or every node that ends its run by itself (``finishes_run``) has finished."""
+    done = [n for n in nodes if n.finished]
+    if not done:
+        return False
+    if any(n.exit_code or not n.finishes_run for n in done):
+        return True
+    return all(n.finished for n in nodes if n.finishes_run)
+
+
 def make_executor(kind: str, context: Context) -> Executor:
     """``events`` (rclpy.experimental.EventsExecutor, the default) or ``single``."""
     if kind == "events":
@@ -221,7 +237,7 @@ def run_nodes(
         monotonic = time.monotonic
         bus = bus_for(context)
         while not received and context.ok():
-            if any(n.finished for n in loop_nodes):
+            if run_over(loop_nodes):
                 break
             now = monotonic()
             timeout = 0.05
