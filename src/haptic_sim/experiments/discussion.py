@@ -104,9 +104,21 @@ relay of bounded amplitude, and what happens then depends on what the linear mod
 
 So the mechanism the thesis guessed at (dissipation over a longer period) is, in the simulator,
 friction stopping a saturated relay oscillation, and the observer's gain sets how stiff a wall it
-holds. The configuration's gain is the fastest whole one below the chatter gain, so no other gain
-that keeps Kf = 100 from chattering holds a stiffer wall in this grid.
+holds. {_best(d, chatter, fc)}
 """
+
+
+def _best(d: DobStudy, chatter: float | None, fc: float) -> str:
+    """Which gain below the chatter gain holds the stiffest wall in the grid (with friction)."""
+    calm = [fv for fv in d.first_vibrating if fv.coulomb_n == fc]
+    calm = [fv for fv in calm if chatter is None or fv.gain < chatter]
+    if not calm:
+        return ""
+    best = max(calm, key=lambda fv: (fv.wall is None, fv.wall or 0.0, fv.gain))
+    return (
+        f"Of the grid's gains below the chatter gain, c = {best.gain:g} N s/m holds the "
+        f"stiffest wall (first vibrating {fmt(best.wall, 'g', 'none')} N/m)."
+    )
 
 
 def phantom_text(p: PhantomResult) -> str:
@@ -144,8 +156,8 @@ OBSERVER_MODEL = (
 HAND_IS_A_MODEL = (
     "- **The hand is a model.** The thesis's users moved the handle themselves; here a "
     "seeded semi-random reference (0.05-10 Hz) drives a mass-spring-damper hand, the "
-    "same for every controller. One seed's 40 s give each cell's bandwidth to about +-20 % "
-    "(the sweeps section's other seeds), the size of the 15 % criterion."
+    "same for every controller; another seed moves some cells by more than the 15 % "
+    "criterion (the sweeps section's table for other seeds)."
 )
 ONSETS_FROM_A_PROTOCOL = (
     "- **Onsets come from a protocol, not a user.** The thesis's onsets are the lowest of "
