@@ -82,9 +82,11 @@ def _every_part() -> dict[str, object]:
         ),
         "sweeps": sweeps.SweepStudy(
             [
-                sweeps.SweepCell("grip", "OL", 0.0, 10.0, 6.04, 25.0, 0.85, -1.6, -1.6, 0.0),
-                sweeps.SweepCell("force_limit", "CL", 2.0, 4.0, None, None, None, None, None, 21.0),
-                sweeps.SweepCell("sensor", "CL", 2.0, 5.0, 8.2, 12.0, 0.98, -0.1, -0.5, 0.0, 588.0),
+                sweeps.SweepCell("grip", "OL", 0.0, 2400.0, 10.0, 6.04, 25.0, 0.85, -1.6, -1.6, 0),
+                sweeps.SweepCell("force_limit", "CL", 2.0, 80.0, 4.0, *[None] * 5, 21.0),
+                sweeps.SweepCell(
+                    "sensor", "CL", 2.0, 1600.0, 5.0, 7.5, 12.0, 0.98, -0.1, -0.5, 0.0, 588.0
+                ),
             ],
             [spread.SeedCell(1, "OL", 0.0, 800.0, 4.07), spread.SeedCell(1, "CL", 2.0, 80.0, None)],
         ),

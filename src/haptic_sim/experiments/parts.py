@@ -253,11 +253,11 @@ SWEEPS: Experiment[sweeps.SweepStudy] = Experiment(
         lambda r: f"Table 7.1's off cells swept: {len(r.cells) + len(r.seeds)} sessions",
     ),
     heading="Table 7.1's cells that stay off, against the parameter responsible (batch)",
-    intro="The controllers of Table 7.1 in the chapter-7 session (40 s, the hand's seed 0, "
-    "as chapter 7's default) at one wall, with one parameter swept from the chapter-7 value: "
+    intro="Controllers of Table 7.1 in the chapter-7 session (40 s, the hand's seed 0, "
+    "as chapter 7's default), with one parameter swept from the chapter-7 value: "
     "the hand's grip damping at 2400 N/m, the actuator's force limit at 80 N/m, the observer "
-    "gain at 1600 N/m (DOB), the force sensor's bandwidth at 2400 N/m (CL); then the whole "
-    "table for other seeds of the hand.",
+    "gain at every wall (DOB), the force sensor's bandwidth at 1600 and 2400 N/m (CL): each "
+    "cell that stays off has its sweep. Then the whole table for other seeds of the hand.",
     body=lambda r, _base: [
         sweeps.sweep_table(r, sweeps.GRIP),
         sweeps_report.grip_text(r),

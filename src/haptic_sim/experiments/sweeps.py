@@ -9,11 +9,11 @@
   handle centimetres; force feedback multiplies the force error by ``1 + Kf``, and CL Kf = 2 and
   DOB Kf = 25 spend much of the session at the 4 N limit: the loop is not linear there, the
   coherence collapses and the band ends at the first bin. A larger limit restores the coherence.
-- **1600 N/m against the observer gain (DOB).** For a large Kf the rendered impedance rises past
+- **Every wall against the observer gain (DOB).** For a large Kf the rendered impedance rises past
   +3 dB near the observer's corner ``c / (2 pi m)``, so DOB Kf = 25's band follows c; DOB Kf = 1
   needs a fast observer to reach the mass line ``m / 2`` the thesis's cells sit near, and a gain
   that fast chatters at Kf = 25 (above about ``2 m / (Kf T)``: the time at the limit).
-- **2400 N/m against the force sensor's bandwidth (CL).** CL's band follows the mass line
+- **1600 and 2400 N/m against the force sensor's bandwidth (CL).** CL's band follows the mass line
   ``m / (1 + Kf)`` above the thesis's 4.5 Hz; a slower sensor lowers it only when it also lowers
   the CL onset of chapter 6's linear protocol below the thesis's 800 N/m (the onset column).
 
@@ -85,27 +85,30 @@ def _sensor_bandwidth(b: SessionConfig) -> float:
 
 @dataclass(frozen=True)
 class Sweep:
-    """One parameter swept at one wall for some controllers of Table 7.1."""
+    """One parameter swept at some walls for some controllers of Table 7.1."""
 
     name: str
-    wall_n_per_m: float
+    walls: tuple[float, ...]  # N/m
     parameter: str  # with its unit
     current: Callable[[SessionConfig], float]  # the chapter-7 session's value, swept first
     values: tuple[float, ...]  # the others
     apply: Callable[[SessionConfig, str, float, float], SessionConfig]  # (cfg, mode, Kf, value)
     controllers: tuple[Controller, ...] = tuple(thesis.BANDWIDTH_HZ)
     onset_walls: tuple[float, ...] = ()  # chapter 6's linear onset over these walls, if any
+    # (once per value: the onset does not depend on chapter 7's wall)
 
     def values_for(self, base: SessionConfig) -> tuple[float, ...]:
         """The chapter-7 value first, then the others."""
         now = self.current(base)
         return (now, *(v for v in self.values if v != now))
 
-    def config(self, base: SessionConfig, mode: str, kf: float, value: float) -> SessionConfig:
-        """The chapter-7 session at this wall with the parameter at ``value``."""
-        offset, amplitude = reference_for_force(self.wall_n_per_m, base.hand.stiffness_n_per_m)
+    def config(
+        self, base: SessionConfig, mode: str, kf: float, wall: float, value: float
+    ) -> SessionConfig:
+        """The chapter-7 session at ``wall`` (N/m) with the parameter at ``value``."""
+        offset, amplitude = reference_for_force(wall, base.hand.stiffness_n_per_m)
         at_wall = base.replace(
-            wall__stiffness_n_per_m=self.wall_n_per_m,
+            wall__stiffness_n_per_m=wall,
             hand__offset_m=offset,
             hand__amplitude_m=amplitude,
             loop__seed=SEED,
@@ -116,7 +119,7 @@ class Sweep:
 
 GRIP = Sweep(
     "grip",
-    2400.0,
+    (2400.0,),
     "grip damping (N s/m)",
     _hand_damping,
     (5.0, 2.0),
@@ -124,7 +127,7 @@ GRIP = Sweep(
 )
 FORCE_LIMIT = Sweep(
     "force_limit",
-    80.0,
+    (80.0,),
     "force limit (N)",
     _max_force,
     (8.0, 16.0, 64.0),
@@ -133,16 +136,16 @@ FORCE_LIMIT = Sweep(
 )
 OBSERVER = Sweep(
     "observer",
-    1600.0,
+    tuple(thesis.WALLS),
     "observer gain (N s/m)",
     _gain,
-    (2.0, 4.0, 10.0, 20.0, 41.6),
+    (4.0, 10.0, 41.6),
     _observer_gain,
     (("DOB", 1.0), ("DOB", 25.0)),
 )
 SENSOR = Sweep(
     "sensor",
-    2400.0,
+    (1600.0, 2400.0),
     "force sensor's bandwidth (Hz)",
     _sensor_bandwidth,
     (50.0, 20.0, 10.0, 5.0),
@@ -160,6 +163,7 @@ class SweepCell:
     sweep: str
     mode: str
     kf: float
+    wall: float  # N/m
     value: float
     bandwidth_hz: float | None
     impedance_error_pct: float | None
@@ -178,31 +182,36 @@ class SweepStudy:
     cells: list[SweepCell]
     seeds: list[spread.SeedCell] = field(default_factory=list)
 
-    def of(self, sweep: str, mode: str, kf: float) -> list[SweepCell]:
-        """One controller's cells of one sweep, in the order run."""
-        return [c for c in self.cells if (c.sweep, c.mode, c.kf) == (sweep, mode, kf)]
+    def of(self, sweep: str, mode: str, kf: float, wall: float | None = None) -> list[SweepCell]:
+        """One controller's cells of one sweep (at one wall, or all), in the order run."""
+        return [
+            c
+            for c in self.cells
+            if (c.sweep, c.mode, c.kf) == (sweep, mode, kf) and wall in (None, c.wall)
+        ]
 
 
-def _session(args: tuple[SessionConfig, Sweep, str, float, float]) -> SweepCell:
-    base, sweep, mode, kf, value = args
-    cfg = sweep.config(base, mode, kf, value)
+def _session(args: tuple[SessionConfig, Sweep, str, float, float, float]) -> SweepCell:
+    base, sweep, mode, kf, wall, value = args
+    cfg = sweep.config(base, mode, kf, wall, value)
     res = run_session(cfg)
     k0 = round(SETTLE_S * cfg.loop.rate_hz)
     limit = cfg.device.max_force_n * (1.0 - 1e-9)
     saturated = float(np.mean(np.abs(res.effort[k0:]) >= limit) * 100.0)
     onset = None
-    if sweep.onset_walls:
+    if sweep.onset_walls and wall == sweep.walls[0]:
         onset = stability_sweep(list(sweep.onset_walls), cfg).onset_stiffness_n_per_m
     try:
-        tr = transparency(res.q[k0:], res.force_measured[k0:], cfg.loop.rate_hz, sweep.wall_n_per_m)
+        tr = transparency(res.q[k0:], res.force_measured[k0:], cfg.loop.rate_hz, wall)
     except ValueError:  # no motion to measure
         nothing = (None, None, None, None, None)
-        return SweepCell(sweep.name, mode, kf, value, *nothing, saturated, onset)
+        return SweepCell(sweep.name, mode, kf, wall, value, *nothing, saturated, onset)
     db = tr.magnitude_db
     return SweepCell(
         sweep.name,
         mode,
         kf,
+        wall,
         value,
         tr.bandwidth_hz,
         tr.impedance_error_pct,
@@ -218,9 +227,10 @@ def study(base: SessionConfig, executor: Executor | None = None) -> SweepStudy:
     """Every sweep for its controllers (``DURATION_S`` sessions, seed ``SEED``) and Table 7.1 for
     the hand's other seeds (``spread``)."""
     jobs = [
-        (base, s, mode, kf, v)
+        (base, s, mode, kf, wall, v)
         for s in SWEEPS
         for (mode, kf) in s.controllers
+        for wall in s.walls
         for v in s.values_for(base)
     ]
     cells = list(executor.map(_session, jobs)) if executor else [_session(j) for j in jobs]
@@ -242,15 +252,16 @@ def _cell_text(c: SweepCell) -> str:
 
 
 def sweep_table(r: SweepStudy, sweep: Sweep) -> str:
-    """One sweep's table: a row per controller, a column per value (in the order run), the
-    thesis's cell last; chapter 6's linear onset per value where the sweep measures it."""
+    """One sweep's table: a row per controller and wall, a column per value (in the order run),
+    the thesis's cell last; chapter 6's linear onset per value where the sweep measures it."""
     values = list(dict.fromkeys(c.value for c in r.cells if c.sweep == sweep.name))
     if not values:
         return ""
+    walls = ", ".join(f"{w:g}" for w in sweep.walls)
     lines = [
-        f"**{sweep.wall_n_per_m:g} N/m against the {sweep.parameter}** (the first column is "
-        "chapter 7's): bandwidth in Hz (coherence in the band); |Z_hat / Z_d| at the first bin / "
-        "its mean up to 5 Hz (dB); time at the force limit"
+        f"**{walls} N/m against the {sweep.parameter}** (the first column is chapter 7's): "
+        "bandwidth in Hz (coherence in the band); |Z_hat / Z_d| at the first bin / its mean up "
+        "to 5 Hz (dB); time at the force limit"
         + ("; chapter 6's linear onset (N/m)" if sweep.onset_walls else "")
         + ":",
         "",
@@ -258,10 +269,12 @@ def sweep_table(r: SweepStudy, sweep: Sweep) -> str:
         "|---|" + "---|" * (len(values) + 1),
     ]
     for mode, kf in sweep.controllers:
-        by_value = {c.value: c for c in r.of(sweep.name, mode, kf)}
-        if not by_value:
-            continue
-        cols = [_cell_text(by_value[v]) if v in by_value else "-" for v in values]
-        ref = thesis.cell(mode, kf, sweep.wall_n_per_m)[0]
-        lines.append(f"| {label(mode, kf)} | " + " | ".join(cols) + f" | {fmt(ref, 'g')} |")
+        for wall in sweep.walls:
+            by_value = {c.value: c for c in r.of(sweep.name, mode, kf, wall)}
+            if not by_value:
+                continue
+            cols = [_cell_text(by_value[v]) if v in by_value else "-" for v in values]
+            ref = thesis.cell(mode, kf, wall)[0]
+            name = label(mode, kf) + ("" if len(sweep.walls) == 1 else f", {wall:g} N/m")
+            lines.append(f"| {name} | " + " | ".join(cols) + f" | {fmt(ref, 'g')} |")
     return "\n".join(lines) + "\n"

@@ -60,7 +60,7 @@ def limit_text(r: SweepStudy) -> str:
         if len(cells) < 2:
             continue
         first, widest = cells[0], max(cells[1:], key=lambda c: c.coherence_in_band or 0.0)
-        ref = thesis.cell(mode, kf, FORCE_LIMIT.wall_n_per_m)[0]
+        ref = thesis.cell(mode, kf, FORCE_LIMIT.walls[0])[0]
         parts.append(
             f"{label(mode, kf)} spends {first.saturated_pct:.0f} % of the session at the "
             f"{first.value:g} N limit (coherence {fmt(first.coherence_in_band)}, band "
@@ -81,8 +81,8 @@ def limit_text(r: SweepStudy) -> str:
     )
 
 
-def _bands(cells: list[SweepCell]) -> str:
-    return ", ".join(f"{c.value:g}: {fmt(c.bandwidth_hz)}" for c in cells)
+def _saturation(c: SweepCell) -> float:
+    return c.saturated_pct
 
 
 def _matching(cells: list[SweepCell], ref: float | None) -> str:
@@ -101,45 +101,49 @@ def observer_text(r: SweepStudy) -> str:
     """What the observer-gain sweep shows, with its own numbers ("" when not run)."""
     parts = []
     for mode, kf in OBSERVER.controllers:
-        cells = r.of(OBSERVER.name, mode, kf)
-        if not cells:
-            continue
-        ref = thesis.cell(mode, kf, OBSERVER.wall_n_per_m)[0]
-        chatter = max(cells, key=lambda c: c.saturated_pct)
-        parts.append(
-            f"{label(mode, kf)}'s band (Hz) per c (N s/m) is {_bands(cells)} (thesis "
-            f"{fmt(ref, 'g')} Hz: within 15 % for c = {_matching(cells, ref)}; the command at "
-            f"the force limit up to {chatter.saturated_pct:.0f} % of the time, at c = "
-            f"{chatter.value:g})"
-        )
+        walls = []
+        for wall in OBSERVER.walls:
+            cells = r.of(OBSERVER.name, mode, kf, wall)
+            if cells:
+                ref = thesis.cell(mode, kf, wall)[0]
+                walls.append(f"c = {_matching(cells, ref)} at {wall:g} N/m")
+        if walls:
+            parts.append(f"{label(mode, kf)}: " + ", ".join(walls))
     if not parts:
         return ""
+    # the chatter's example where the force limit alone does not saturate (not at 80 N/m)
+    swept = [c for c in r.cells if c.sweep == OBSERVER.name]
+    chatter = max([c for c in swept if c.wall >= 800.0] or swept, key=_saturation)
     return (
-        f"At {OBSERVER.wall_n_per_m:g} N/m: "
+        "The gains whose band is within 15 % of the thesis's, per wall: "
         + "; ".join(parts)
         + ". For a large Kf the rendered impedance rises past +3 dB near the observer's corner "
         "c / (2 pi m), so the high-gain band follows the gain; the low-gain DOB reaches its mass "
-        "line only with a faster observer, and a gain that fast chatters at the sample rate at "
-        "Kf = 25 (above about 2 m / (Kf T), the time at the limit) and at the thesis's Kf = 100 "
-        "(the DOB section). The chapter-7 gain (the first column) is the fastest that does not.\n"
+        "line m / 2 only with a faster observer, and a gain that fast chatters at the sample rate "
+        f"at Kf = 25 ({label(chatter.mode, chatter.kf)} at {chatter.wall:g} N/m with c = "
+        f"{chatter.value:g}: the command at the force limit {chatter.saturated_pct:.0f} % of the "
+        "time) and at the thesis's Kf = 100 (the DOB section), where the chapter-7 gain (the first "
+        "column) is set below it.\n"
     )
 
 
 def sensor_text(r: SweepStudy) -> str:
     """What the sensor sweep shows, with its own numbers ("" when not run)."""
-    cells = r.of(SENSOR.name, "CL", 2.0)
-    if len(cells) < 2:
+    wall = SENSOR.walls[-1]
+    cells = r.of(SENSOR.name, "CL", 2.0, wall)
+    onsets = [c for c in r.of(SENSOR.name, "CL", 2.0) if c.onset_n_per_m is not None]
+    if len(cells) < 2 or len(onsets) < 2:
         return ""
     first, last = cells[0], cells[-1]
-    ref = thesis.cell("CL", 2.0, SENSOR.wall_n_per_m)[0]
+    ref = thesis.cell("CL", 2.0, wall)[0]
     return (
-        f"CL Kf=2 at {SENSOR.wall_n_per_m:g} N/m keeps a {fmt(first.bandwidth_hz)} Hz band with "
-        f"the chapter-7 sensor ({first.value:g} Hz); a {last.value:g} Hz sensor gives "
+        f"CL Kf=2 at {wall:g} N/m keeps a {fmt(first.bandwidth_hz)} Hz band with the chapter-7 "
+        f"sensor ({first.value:g} Hz); a {last.value:g} Hz sensor gives "
         f"{fmt(last.bandwidth_hz)} Hz (thesis {fmt(ref, 'g')} Hz) and moves chapter 6's linear CL "
-        f"onset from {fmt(first.onset_n_per_m, '.0f')} to {fmt(last.onset_n_per_m, '.0f')} N/m "
-        f"(thesis {thesis.ONSET_N_PER_M['CL']:g} N/m). The thesis's CL cells above 800 N/m lie "
-        "below the mass line m / (1 + Kf) that the simulated CL follows, and the sensor's "
-        "bandwidth is not what puts them there.\n"
+        f"onset from {fmt(onsets[0].onset_n_per_m, '.0f')} to "
+        f"{fmt(onsets[-1].onset_n_per_m, '.0f')} N/m (thesis {thesis.ONSET_N_PER_M['CL']:g} N/m). "
+        "The thesis's CL cells above 800 N/m lie below the mass line m / (1 + Kf) that the "
+        "simulated CL follows, and the sensor's bandwidth is not what puts them there.\n"
     )
 
 
