@@ -130,7 +130,7 @@ FORCE_LIMIT = Sweep(
     (80.0,),
     "force limit (N)",
     _max_force,
-    (8.0, 16.0, 64.0),
+    (8.0, 16.0),
     _force_limit,
     (("CL", 2.0), ("DOB", 25.0)),
 )
@@ -139,7 +139,7 @@ OBSERVER = Sweep(
     tuple(thesis.WALLS),
     "observer gain (N s/m)",
     _gain,
-    (4.0, 10.0, 41.6),
+    (10.0, 41.6),
     _observer_gain,
     (("DOB", 1.0), ("DOB", 25.0)),
 )
@@ -148,7 +148,7 @@ SENSOR = Sweep(
     (1600.0, 2400.0),
     "force sensor's bandwidth (Hz)",
     _sensor_bandwidth,
-    (50.0, 20.0, 10.0, 5.0),
+    (20.0, 5.0),
     _sensor,
     (("CL", 2.0),),
     (400.0, 500.0, 600.0, 700.0, 800.0, 900.0, 1000.0),
