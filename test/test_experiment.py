@@ -317,6 +317,10 @@ def test_report_renders_every_section(tmp_path) -> None:
         [dob.LinearOnset(100.0, 7.0, 1.0, 23.0)],
         [dob.ChatterGain(100.0, 7.7, 8.4)],
         [],
+        [
+            dob.GripPoint(g.name, 2400.0, 3e-4 if g is dob.GRIPS[0] else 0.0, 25.0)
+            for g in dob.GRIPS
+        ],
     )
     res = ExperimentResults(
         config="slide_sim",
@@ -338,6 +342,8 @@ def test_report_renders_every_section(tmp_path) -> None:
     flat = " ".join(text.split())
     assert "up to 2000 N/m; the first wall that keeps vibrating is 2400 N/m (the thesis" in flat
     assert "(7.7 N s/m at Kf = 100 with the amplifier lag)" in flat
+    assert "light grip the first wall that keeps vibrating is 2400 N/m, with a hand as on" in flat
+    assert "5 N s/m) none up to 2400 N/m; the thesis does not say" in flat
     # the one configuration comes first, before any part's section
     assert text.index("## One plant and one observer configuration") < text.index("## Chapter 7")
     assert (
@@ -352,18 +358,21 @@ def test_dob_kf_100_sticks_with_friction_to_a_wall_and_vibrates_without() -> Non
     """The mechanism of the report's DOB section, cell by cell (chapter 6's tap, DOB Kf = 100,
     the configuration's observer): with the plant's friction the tap dies out at 2000 N/m and
     keeps a vibration at 2400 N/m (measured 0.0 and 329 um RMS at 25 Hz); without Coulomb
-    friction 1600 N/m vibrates too; a gain above the chatter gain (10 N s/m) hunts at 800 N/m."""
+    friction 1600 N/m vibrates too; a gain above the chatter gain (10 N s/m) hunts at 800 N/m;
+    a bench hand (0.1 kg, 300 N/m, 5 N s/m) instead of the light grip keeps 2400 N/m quiet."""
     base = SessionConfig.from_yaml(CONFIG).replace(law=law_for("DOB", 100.0))
     c = base.observer.gain
     quiet = dob.kick_point(base, 2000.0, c, True)
     loud = dob.kick_point(base, 2400.0, c, True)
     frictionless = dob.kick_point(base, 1600.0, c, False)
     hunting = dob.kick_point(base, 800.0, 10.0, True)
+    bench = dob.grip_point(base, 2400.0, dob.GRIPS[1])  # a firmer, damped hand holds it
     assert not quiet.vibrates, quiet
     assert loud.vibrates and loud.residual_rms_m > 50 * dob.VIBRATION_RMS_M, loud
     assert 10.0 < loud.frequency_hz < 60.0, loud
     assert frictionless.vibrates, frictionless
     assert hunting.vibrates and hunting.residual_rms_m < 20 * dob.VIBRATION_RMS_M, hunting
+    assert not bench.vibrates, bench
 
 
 def test_a_recorded_run_counts_only_with_the_same_parameters(tmp_path) -> None:

@@ -79,6 +79,7 @@ def _every_part() -> dict[str, object]:
             [dob.LinearOnset(100.0, 7.0, 0.0, None)],
             [dob.ChatterGain(100.0, 7.7, 8.4), dob.ChatterGain(1.0, 1322.0, None)],
             [dob.MismatchCell(800.0, 25.0, m, 3.0, 30.0) for m in ("assumed", "no Coulomb")],
+            [dob.GripPoint("bench hand", 3200.0, 0.0, 1.0)],
         ),
         "sweeps": sweeps.SweepStudy(
             [

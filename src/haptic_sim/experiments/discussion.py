@@ -7,7 +7,7 @@ the parts that were run (``parts.EXPERIMENTS``).
 from __future__ import annotations
 
 from haptic_sim.experiments import thesis
-from haptic_sim.experiments.dob import DobStudy
+from haptic_sim.experiments.dob import GRIPS, DobStudy, first_vibrating_with
 from haptic_sim.experiments.phantom import PhantomResult
 from haptic_sim.experiments.records import RunAnalysis
 from haptic_sim.experiments.results import bound
@@ -104,8 +104,23 @@ relay of bounded amplitude, and what happens then depends on what the linear mod
 
 So the mechanism the thesis guessed at (dissipation over a longer period) is, in the simulator,
 friction stopping a saturated relay oscillation, and the observer's gain sets how stiff a wall it
-holds. {_best(d, chatter, fc)}
+holds. {_best(d, chatter, fc)} {_hands(d)}
 """
+
+
+def _hands(d: DobStudy) -> str:
+    """What the hand changes (the grip table), from the results."""
+    walls = {g.name: first_vibrating_with(d.grips, g.name) for g in GRIPS}
+    if len(walls) < 2 or not d.grips:
+        return ""
+    light, bench = (walls[g.name] for g in GRIPS)
+    top = max(p.stiffness_n_per_m for p in d.grips)
+    return (
+        f"The hand decides as much: with chapter 6's light grip the first wall that keeps "
+        f"vibrating is {fmt(light, 'g', 'none')} N/m, with a hand as on the bench (0.1 kg, "
+        f"300 N/m, 5 N s/m) {fmt(bench, 'g', f'none up to {top:g}')} N/m; the thesis does not "
+        "say how its user held the handle."
+    )
 
 
 def _best(d: DobStudy, chatter: float | None, fc: float) -> str:

@@ -106,15 +106,50 @@ class MismatchCell:
 
 
 @dataclass(frozen=True)
+class Grip:
+    """A hand holding the handle for the tap: its mass (kg), grip stiffness (N/m) and damping
+    (N s/m)."""
+
+    name: str
+    mass_kg: float
+    stiffness_n_per_m: float
+    damping_n_s_per_m: float
+
+
+#: chapter 6's light grip, and a hand as on the bench
+GRIPS = (Grip("light grip", 0.0, 20.0, 0.0), Grip("bench hand", 0.1, 300.0, 5.0))
+
+
+@dataclass(frozen=True)
+class GripPoint:
+    """The residual vibration after the tap at one wall with one hand (the configuration's
+    observer and friction)."""
+
+    grip: str
+    stiffness_n_per_m: float
+    residual_rms_m: float
+    frequency_hz: float
+
+    JSON_DERIVED: ClassVar[tuple[str, ...]] = ("vibrates",)
+
+    @property
+    def vibrates(self) -> bool:
+        """True when the motion is still there 2-3 s after the tap."""
+        return self.residual_rms_m > VIBRATION_RMS_M
+
+
+@dataclass(frozen=True)
 class DobStudy:
     """The dob part's result: the tap grid and its first vibrating walls, the linear model's
-    onsets and chatter gains, and the transparency with a mismatched observer model."""
+    onsets and chatter gains, the transparency with a mismatched observer model, and the tap
+    with another hand."""
 
     kick: list[KickPoint]
     first_vibrating: list[FirstVibrating]
     linear: list[LinearOnset]
     chatter: list[ChatterGain]
     model_mismatch: list[MismatchCell]
+    grips: list[GripPoint]
 
     def first_wall(self, gain: float, coulomb_n: float) -> float | None:
         """The first vibrating wall (N/m) of one (c, Coulomb) row; None if none or not run."""
@@ -140,6 +175,18 @@ def kick_point(base: SessionConfig, stiffness: float, gain: float, friction: boo
     cfg = tapped(base, stiffness, gain, friction)
     rms, freq = tap_residual(run_session(cfg).q, cfg.loop.rate_hz)
     return KickPoint(stiffness, gain, cfg.device.coulomb_n, rms, freq)
+
+
+def grip_point(base: SessionConfig, stiffness: float, grip: Grip) -> GripPoint:
+    """The tap at one wall with ``grip`` holding the handle (DOB, the base's Kf, gain, friction)."""
+    cfg = tapped(base, stiffness, base.observer.gain, True).replace(
+        hand__mass_kg=grip.mass_kg,
+        hand__stiffness_n_per_m=grip.stiffness_n_per_m,
+        hand__damping_n_s_per_m=grip.damping_n_s_per_m,
+        hand__offset_m=TAP.push_n * (1.0 / stiffness + 1.0 / grip.stiffness_n_per_m),
+    )
+    rms, freq = tap_residual(run_session(cfg).q, cfg.loop.rate_hz)
+    return GripPoint(grip.name, stiffness, rms, freq)
 
 
 def kick_grid(
@@ -259,10 +306,21 @@ def study(base: SessionConfig, executor: Executor | None = None) -> DobStudy:
     """The whole mechanism study (batch; ``executor``: a shared process pool)."""
     kick = kick_grid(base, executor=executor)
     rows = sorted({(p.gain, p.coulomb_n) for p in kick})
+    dob = base.replace(law=law_for("DOB", 100.0, base.law.max_force_n))
+    cells = [(w, g) for g in GRIPS for w in WALLS]
+    args = ([dob] * len(cells), [w for w, _ in cells], [g for _, g in cells])
+    grips = list(executor.map(grip_point, *args)) if executor else list(map(grip_point, *args))
     return DobStudy(
         kick,
         [FirstVibrating(c, fc, first_vibrating(kick, c, fc)) for c, fc in rows],
         linear_onsets(base, gains_of(base), LINEAR_KFS),
         chatter_gains(base, LINEAR_KFS),
         model_mismatch(base, executor=executor),
+        grips,
     )
+
+
+def first_vibrating_with(points: list[GripPoint], grip: str) -> float | None:
+    """The lowest wall (N/m) that keeps vibrating after the tap with one hand; None if none."""
+    row = sorted((p for p in points if p.grip == grip), key=lambda p: p.stiffness_n_per_m)
+    return next((p.stiffness_n_per_m for p in row if p.vibrates), None)

@@ -231,9 +231,9 @@ DOB: Experiment[dob.DobStudy] = Experiment(
     ),
     heading="The DOB question: quiet at Kf = 100 up to 2400 N/m",
     intro="Chapter 6's tap in batch (a light 20 N/m grip pushing 1 N into the wall, a 3 N "
-    "tap for 20 ms) with DOB at Kf = 100, over the observer gain and with the plant's "
-    "friction kept or off; the residual motion 2-3 s after the tap says whether the wall "
-    "keeps vibrating.",
+    "tap for 20 ms) with DOB at Kf = 100, over the observer gain, with the plant's friction "
+    "kept or off, and with a firmer hand; the residual motion 2-3 s after the tap says "
+    "whether the wall keeps vibrating.",
     body=lambda r, base: [tables.dob_tables(r), discussion.dob_discussion(r, base.observer.gain)],
     figures=(
         Figure(

@@ -7,7 +7,14 @@ from collections.abc import Callable
 
 from haptic_dob.analysis.linear_loop import chatter_gain
 from haptic_sim.experiments import thesis
-from haptic_sim.experiments.dob import WALLS, DobStudy, KickPoint
+from haptic_sim.experiments.dob import (
+    GRIPS,
+    WALLS,
+    DobStudy,
+    GripPoint,
+    KickPoint,
+    first_vibrating_with,
+)
 from haptic_sim.experiments.plan import CH7_CONTROLLERS
 from haptic_sim.experiments.records import (
     ExperimentResults,
@@ -168,6 +175,11 @@ def _kick_cell(p: KickPoint) -> str:
     return f"{rms} @ {p.frequency_hz:.0f} Hz" if p.vibrates else rms
 
 
+def _grip_cell(p: GripPoint) -> str:
+    rms = f"{p.residual_rms_m * 1e6:.1f}"
+    return f"{rms} @ {p.frequency_hz:.0f} Hz" if p.vibrates else rms
+
+
 def dob_tables(d: DobStudy) -> str:
     """Tables of the mechanism study."""
     lines = [
@@ -215,6 +227,26 @@ def dob_tables(d: DobStudy) -> str:
             + " | ".join(cols)
             + f" | {fmt(fv.wall, 'g', 'none')} |"
         )
+    if d.grips:
+        lines += [
+            "",
+            "**The tap with another hand** (DOB Kf = 100, the configuration's gain and friction; "
+            "residual motion 2-3 s after the tap, um RMS):",
+            "",
+            "| hand | " + " | ".join(f"{w:g}" for w in WALLS) + " | first wall that vibrates |",
+            "|---|" + "---|" * (len(WALLS) + 1),
+        ]
+        for grip in GRIPS:
+            by_wall = {p.stiffness_n_per_m: p for p in d.grips if p.grip == grip.name}
+            if not by_wall:
+                continue
+            taps = [_grip_cell(by_wall[w]) for w in WALLS if w in by_wall]
+            first = fmt(first_vibrating_with(d.grips, grip.name), "g", "none")
+            hand = (
+                f"{grip.name}: {grip.mass_kg:g} kg, {grip.stiffness_n_per_m:g} N/m, "
+                f"{grip.damping_n_s_per_m:g} N s/m"
+            )
+            lines.append(f"| {hand} | " + " | ".join(taps) + f" | {first} |")
     if d.model_mismatch:
         lines += [
             "",
