@@ -9,20 +9,23 @@ acceptance checks, the report's rendering, and the DOB mechanism the report expl
 from __future__ import annotations
 
 import json
-import math
 import signal
 import subprocess
 import time
+from pathlib import Path
 
 import pytest
 
 from conftest import tool
+from haptic_dob.runtime.params import load_node_params
 from haptic_sim.experiments import dob, results
 from haptic_sim.experiments.parts import CH7, load_results
-from haptic_sim.experiments.plan import chapter6_runs, chapter7_runs
+from haptic_sim.experiments.plan import chapter6_plan, chapter6_runs, chapter7_runs
 from haptic_sim.experiments.records import Cell, ExperimentResults, RunAnalysis
 from haptic_sim.session import SessionConfig
 from haptic_sim.stability import law_for
+
+CONFIG = Path(__file__).resolve().parents[1] / "config" / "slide_sim.yaml"
 
 
 @pytest.mark.slow
@@ -151,6 +154,19 @@ def test_the_plan_holds_the_thesis_cells(root) -> None:
     assert any(w < 2544 for w in walls["OL"]) and any(w > 2544 for w in walls["OL"])
     assert any(w < 848 for w in walls["CL"]) and any(w > 848 for w in walls["CL"])
     assert all(r.params["/**"]["slide.coulomb_n"] == 0.0 for r in ch6)
+    assert all(r.params["device_node"]["plant.coulomb_n"] == 0.0 for r in ch6)
+    # the tap keeps the configuration's plant and model: no friction (or other plant) override
+    tap = [r for r in chapter6_plan(config, 0, False) if r.cell.part == "ch6tap"]
+    base = load_node_params(config)
+    assert {r.cell.mode for r in tap} == {"OL", "CL", "DOB"}
+    for r in tap:
+        assert r.params["/**"] == base["/**"]
+        dev = r.params["device_node"]
+        assert {k: v for k, v in dev.items() if k.startswith("plant.")} == {
+            k: v for k, v in base["device_node"].items() if k.startswith("plant.")
+        }
+        assert r.params["device_node"]["hand.perturbation_n"] == 3.0
+    assert {r.cell.wall for r in tap if r.cell.mode == "DOB"} >= {800.0, 1600.0, 2400.0, 3200.0}
 
 
 def test_chapter_4_runs_hold_the_slide_in_a_spring_and_add_the_thesiss_inputs(root) -> None:
@@ -273,7 +289,7 @@ def test_ch7_checks_compare_with_the_thesis_and_with_ol() -> None:
 def test_report_renders_every_section(tmp_path) -> None:
     from haptic_sim.experiments import report
 
-    base = SessionConfig()
+    base = SessionConfig.from_yaml(CONFIG)
     ch7 = [
         RunAnalysis(
             "ch7",
@@ -292,15 +308,19 @@ def test_report_renders_every_section(tmp_path) -> None:
     ]
     ch6 = [_row("OL", 0.0, 2200.0, -0.1, False), _row("OL", 0.0, 2600.0, 0.2, True)]
     kick = [
-        dob.KickPoint(w, 2.0, 0.24, r, 40.0)
-        for w, r in zip(dob.WALLS, [0, 0, 0, 0, 7e-5, 9e-5], strict=True)
+        dob.KickPoint(w, 7.0, 0.24, r, 25.0)
+        for w, r in zip(dob.WALLS, [0, 0, 0, 3e-4, 4e-4, 4e-4, 4e-4], strict=True)
     ]
     study = dob.DobStudy(
         kick,
-        [dob.FirstVibrating(2.0, 0.24, dob.first_vibrating(kick, 2.0, 0.24))],
-        [dob.LinearOnset(100.0, 2.0, 0.0, 26.0)],
-        [dob.GainBandwidth(2.0, 1.0, 800.0, 1.2, 48.0)],
+        [dob.FirstVibrating(7.0, 0.24, dob.first_vibrating(kick, 7.0, 0.24))],
+        [dob.LinearOnset(100.0, 7.0, 1.0, 23.0)],
+        [dob.ChatterGain(100.0, 7.7, 8.4)],
         [],
+        [
+            dob.GripPoint(g.name, 2400.0, 3e-4 if g is dob.GRIPS[0] else 0.0, 25.0)
+            for g in dob.GRIPS
+        ],
     )
     res = ExperimentResults(
         config="slide_sim",
@@ -319,7 +339,13 @@ def test_report_renders_every_section(tmp_path) -> None:
     text = path.read_text()
     assert "| OL | 1.08 / 1.3 | 1.80 / 3.8 |" in text  # simulation beside thesis Table 7.1
     assert "| OL | 2333 | 2544 | 2400 |" in text
-    assert "first wall that keeps vibrating is 3200 N/m, as in the thesis" in " ".join(text.split())
+    flat = " ".join(text.split())
+    assert "up to 2000 N/m; the first wall that keeps vibrating is 2400 N/m (the thesis" in flat
+    assert "(7.7 N s/m at Kf = 100 with the amplifier lag)" in flat
+    assert "light grip the first wall that keeps vibrating is 2400 N/m, with a hand as on" in flat
+    assert "5 N s/m) none up to 2400 N/m; the thesis does not say" in flat
+    # the one configuration comes first, before any part's section
+    assert text.index("## One plant and one observer configuration") < text.index("## Chapter 7")
     assert (
         "- [x] OL onset through the graph 2333 N/m within +-5 % of the linear model's 2314 N/m "
         "(bound without the amplifier lag 2544 N/m)"
@@ -328,17 +354,25 @@ def test_report_renders_every_section(tmp_path) -> None:
         assert (tmp_path / "figures" / fig).is_file()
 
 
-def test_dob_stays_quiet_with_friction_and_a_slow_observer_and_vibrates_without() -> None:
-    """The mechanism of the report's DOB section, cell by cell (DOB Kf = 100, c = 2)."""
-    dob100 = SessionConfig().replace(law=law_for("DOB", 100.0))
-    p = dob.KickProtocol()
-    quiet = dob.kick_point(p, dob100, 1600.0, 2.0, 0.24)
-    chatter = dob.kick_point(p, dob100, 1600.0, 2.0, 0.0)
-    loud = dob.kick_point(p, dob100, 3200.0, 2.0, 0.24)
+def test_dob_kf_100_sticks_with_friction_to_a_wall_and_vibrates_without() -> None:
+    """The mechanism of the report's DOB section, cell by cell (chapter 6's tap, DOB Kf = 100,
+    the configuration's observer): with the plant's friction the tap dies out at 2000 N/m and
+    keeps a vibration at 2400 N/m (measured 0.0 and 329 um RMS at 25 Hz); without Coulomb
+    friction 1600 N/m vibrates too; a gain above the chatter gain (10 N s/m) hunts at 800 N/m;
+    a bench hand (0.1 kg, 300 N/m, 5 N s/m) instead of the light grip keeps 2400 N/m quiet."""
+    base = SessionConfig.from_yaml(CONFIG).replace(law=law_for("DOB", 100.0))
+    c = base.observer.gain
+    quiet = dob.kick_point(base, 2000.0, c, True)
+    loud = dob.kick_point(base, 2400.0, c, True)
+    frictionless = dob.kick_point(base, 1600.0, c, False)
+    hunting = dob.kick_point(base, 800.0, 10.0, True)
+    bench = dob.grip_point(base, 2400.0, dob.GRIPS[1])  # a firmer, damped hand holds it
     assert not quiet.vibrates, quiet
-    assert chatter.vibrates and chatter.residual_rms_m > 10 * dob.VIBRATION_RMS_M, chatter
-    assert loud.vibrates, loud
-    assert math.isfinite(loud.frequency_hz) and 20.0 < loud.frequency_hz < 100.0
+    assert loud.vibrates and loud.residual_rms_m > 50 * dob.VIBRATION_RMS_M, loud
+    assert 10.0 < loud.frequency_hz < 60.0, loud
+    assert frictionless.vibrates, frictionless
+    assert hunting.vibrates and hunting.residual_rms_m < 20 * dob.VIBRATION_RMS_M, hunting
+    assert not bench.vibrates, bench
 
 
 def test_a_recorded_run_counts_only_with_the_same_parameters(tmp_path) -> None:

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from haptic_dob.identification import SlideFit
-from haptic_sim.experiments import ch4, ch5, dob, report, results, sweeps
+from haptic_sim.experiments import ch4, ch5, dob, report, results, spread, sweeps
 from haptic_sim.experiments.jsonio import from_json, to_json
 from haptic_sim.experiments.parts import (
     EXPERIMENTS,
@@ -44,7 +44,7 @@ def _every_part() -> dict[str, object]:
         _run("ch6", "OL", 0.0, 2400.0, perturbation_growth_per_s=-0.1, perturbation_vibrates=False),
         _run("ch6", "OL", 0.0, 2800.0, perturbation_growth_per_s=None, perturbation_vibrates=True),
     ]
-    kick = [dob.KickPoint(w, 2.0, 0.24, 1e-5 * w / 4000.0, 30.0) for w in dob.WALLS]
+    kick = [dob.KickPoint(w, 7.0, 0.24, 1e-5 * w / 4000.0, 30.0) for w in dob.WALLS]
     fits = [
         SlideFit("least_squares", "slide", 0.42, 1.25, 0.245, 1e-3, 0.02, 4e-3, 900, 0.01),
         SlideFit("step", "slide", 0.41, 2.04, None, None, None, None, 3500, None),
@@ -75,16 +75,21 @@ def _every_part() -> dict[str, object]:
         ),
         "dob": dob.DobStudy(
             kick,
-            [dob.FirstVibrating(2.0, 0.24, dob.first_vibrating(kick, 2.0, 0.24))],
-            [dob.LinearOnset(100.0, 2.0, 0.0, None)],
-            [dob.GainBandwidth(2.0, 1.0, 800.0, None, 48.0)],
+            [dob.FirstVibrating(7.0, 0.24, dob.first_vibrating(kick, 7.0, 0.24))],
+            [dob.LinearOnset(100.0, 7.0, 0.0, None)],
+            [dob.ChatterGain(100.0, 7.7, 8.4), dob.ChatterGain(1.0, 1322.0, None)],
             [dob.MismatchCell(800.0, 25.0, m, 3.0, 30.0) for m in ("assumed", "no Coulomb")],
+            [dob.GripPoint("bench hand", 3200.0, 0.0, 1.0)],
         ),
         "sweeps": sweeps.SweepStudy(
             [
-                sweeps.SweepCell("grip", "OL", 0.0, 10.0, 6.04, 25.0, 0.85, -1.6, -1.6, 0.0),
-                sweeps.SweepCell("force_limit", "CL", 2.0, 4.0, None, None, None, None, None, 21.0),
-            ]
+                sweeps.SweepCell("grip", "OL", 0.0, 2400.0, 10.0, 6.04, 25.0, 0.85, -1.6, -1.6, 0),
+                sweeps.SweepCell("force_limit", "CL", 2.0, 80.0, 4.0, *[None] * 5, 21.0),
+                sweeps.SweepCell(
+                    "sensor", "CL", 2.0, 1600.0, 5.0, 7.5, 12.0, 0.98, -0.1, -0.5, 0.0, 588.0
+                ),
+            ],
+            [spread.SeedCell(1, "OL", 0.0, 800.0, 4.07), spread.SeedCell(1, "CL", 2.0, 80.0, None)],
         ),
         "phantom": PhantomResult(
             [0.0, 0.012, 0.004], [0.0, 0.95, 0.49], [PhantomWallCell(1.0, 0.3, 8e-5, 0.008)]
@@ -189,7 +194,8 @@ def test_the_report_has_a_section_per_part_run_in_the_tables_order(tmp_path: Pat
     text = report.write(tmp_path, _results(chosen), BASE).read_text()
     headings = [line for line in text.splitlines() if line.startswith("## ")]
     expected = [f"## {e.heading}" for e in EXPERIMENTS if e.part in chosen]
-    assert headings[: len(expected)] == expected
+    assert headings[0] == "## One plant and one observer configuration"  # stated once, first
+    assert headings[1 : len(expected) + 1] == expected
     for e in EXPERIMENTS:
         for f in e.figures:
             assert (f"![{f.alt}](figures/{f.file})" in text) == (e.part in chosen)

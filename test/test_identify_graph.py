@@ -47,11 +47,12 @@ def test_the_graph_bag_gives_the_plants_model_and_the_observer_loads_it(
         if p["method"] == "least_squares":
             assert p["rms_error_mm"] < 0.5, p["excitation"]
 
-    # thesis 5.3: the observer against the force sensor and the true force, as recorded
-    # (lockstep: the same numbers on any machine; measured 0.401 / 0.411 and 0.224 / 0.229 N)
+    # thesis 5.3: the observer (the config's c = 7 N s/m, m/c = 60 ms) against the force sensor
+    # and the true force, as recorded (lockstep: the same numbers on any machine; in batch
+    # 0.746 / 0.749 N in free space and 0.356 / 0.357 N against the wall, nearly all the lag)
     free, wall = json.loads((out / "results.json").read_text())["results"]["ch5"]["runs"]
-    assert free["rms_estimate_vs_sensor_n"] < 0.45 and free["rms_estimate_vs_true_n"] < 0.45
-    assert wall["rms_estimate_vs_sensor_n"] < 0.25 and wall["rms_estimate_vs_true_n"] < 0.25
+    assert free["rms_estimate_vs_sensor_n"] < 0.8 and free["rms_estimate_vs_true_n"] < 0.8
+    assert wall["rms_estimate_vs_sensor_n"] < 0.4 and wall["rms_estimate_vs_true_n"] < 0.4
     assert free["clipped_pct"] == wall["clipped_pct"] == 0.0
     assert free["rms_sensor_vs_true_n"] < 0.02 and wall["rms_sensor_vs_true_n"] < 0.02
 

@@ -144,7 +144,7 @@ def test_sets_override_the_config(root) -> None:
     )
     assert params["controller_node"]["kf"] == 2.0
     assert params["recorder_node"] == {"output": "b"}  # a node the config does not start
-    assert params["/**"]["slide.mass_kg"] == pytest.approx(0.416)  # flattened
+    assert params["/**"]["slide.mass_kg"] == pytest.approx(0.4193)  # flattened
 
 
 def test_a_config_naming_an_unknown_node_is_refused(tmp_path) -> None:

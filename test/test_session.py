@@ -39,9 +39,14 @@ def test_command_k_uses_sample_k() -> None:
     np.testing.assert_allclose(r.command, np.clip(expected, -4.0, 4.0), atol=1e-12)
 
 
-def test_yaml_config_is_the_default_session(root) -> None:
+def test_yaml_config_is_the_default_session_with_an_identified_model_and_its_gain(root) -> None:
+    """The config is the code's default session, except what the observer and the controller
+    assume (the model identified from the plant, test_identified_model) and the observer gain."""
     cfg = SessionConfig.from_yaml(root / "config" / "slide_sim.yaml")
-    assert cfg == SessionConfig()
+    default = SessionConfig()
+    assert cfg.replace(model=default.model, observer=default.observer) == default
+    assert cfg.model != default.model and cfg.device == default.device  # the plant: the default
+    assert cfg.observer.gain == 7.0 and cfg.observer.output_limit == default.observer.output_limit
 
 
 def test_node_params_take_the_plant_from_the_device_and_the_model_from_the_observer() -> None:

@@ -35,9 +35,10 @@ class ArmSpec:
     joints: tuple[str, ...] = ()
 
 
-#: the Coulomb friction of a method that does not identify it
+#: why a fit has no Coulomb friction: the step method separates it from the swings' decay only
+#: where the effort holds the rendered spring (it then falls back to the thesis's formulas)
 NO_COULOMB = {
-    "step": "- (not separated from the damping: the effort holds no spring)",
+    "step": "- (the effort holds no spring: the thesis's formulas, friction read as damping)",
     "thesis_step": "- (the thesis's formulas leave it out)",
 }
 

@@ -6,7 +6,8 @@ Protocol (linear in-contact onset, thesis 6.1 / theory sheet section 4):
    (``grip_n_per_m`` = 20 N/m, no hand mass, no grip damping): almost a pure force source, so
    the hand adds neither damping nor inertia (the worst case, as the thesis notes for 5.2.2).
 2. Coulomb friction is off in the plant and in the observer's model by default: with it, small
-   oscillations stick and die out whatever the stiffness (``coulomb_n`` puts it back). Viscous
+   oscillations stick and die out whatever the stiffness (``coulomb_n`` puts a value in both,
+   ``coulomb_n=None`` keeps the configuration's plant and model as they are). Viscous
    friction, encoder quantization, sensor noise and saturation stay as configured.
 3. After the push has settled (ramp 1 s, pulse at 1.5 s) a force pulse of ``pulse_n`` (0.5 N)
    for 5 ms excites the contact mode.
@@ -18,6 +19,11 @@ Protocol (linear in-contact onset, thesis 6.1 / theory sheet section 4):
    rate is not measured (NaN).
 5. The onset stiffness is the first zero crossing of the growth rate along the sweep, linearly
    interpolated between the last decaying and the first growing stiffness.
+
+``TAP`` is chapter 6's other protocol, for a loop that only a nonlinearity keeps quiet (DOB at
+Kf = 100 is linearly unstable at every wall): the same hand and push, the configuration's friction
+kept, and a tap of 3 N for 20 ms (the thesis's user tried to provoke vibration); a wall vibrates
+when the motion 2-3 s after the tap is larger than ``VIBRATION_RMS_M`` (``residual``).
 
 Theory bound beside it: ``K (1 + Kf) < 2 b / T`` (Colgate & Schenkel; thesis 6.3 with Kf), i.e.
 2544 N/m open loop and 848 N/m for CL with Kf = 2 on the thesis's slide.
@@ -32,6 +38,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from scipy import signal
 
 from haptic_dob.analysis.vibration import perturbation_response
 from haptic_dob.control import ControlMode, ImpedanceLaw
@@ -53,14 +60,15 @@ class StabilityProtocol:
     ramp_s: float = 1.0
     pulse_at_s: float = 1.5
     observe_s: float = 2.5
-    coulomb_n: float = 0.0
+    coulomb_n: float | None = 0.0  # None: the configuration's plant and model as they are
 
     def __post_init__(self) -> None:
         positive("push_n", self.push_n)
         positive("grip_n_per_m", self.grip_n_per_m)
         positive("pulse_s", self.pulse_s)
         positive("observe_s", self.observe_s)
-        nonnegative("coulomb_n", self.coulomb_n)
+        if self.coulomb_n is not None:
+            nonnegative("coulomb_n", self.coulomb_n)
         if self.pulse_at_s < self.ramp_s:
             raise ValueError("pulse_at_s must not come before the end of the ramp")
 
@@ -80,13 +88,37 @@ class StabilityProtocol:
             perturbation_s=self.pulse_s,
         )
         wall = VirtualWall(k, base.wall.damping_n_s_per_m, base.wall.position, base.wall.normal)
-        return base.replace(
-            hand=hand,
-            model__coulomb_n=self.coulomb_n,  # the plant's and the assumed model's alike
-            device__coulomb_n=self.coulomb_n,
-            wall=wall,
-            loop__duration_s=self.pulse_at_s + self.observe_s,
-        )
+        if self.coulomb_n is not None:  # the plant's and the assumed model's alike
+            base = base.replace(model__coulomb_n=self.coulomb_n, device__coulomb_n=self.coulomb_n)
+        return base.replace(hand=hand, wall=wall, loop__duration_s=self.duration_s)
+
+    @property
+    def duration_s(self) -> float:
+        """The session's length (s): the pulse's time and the observation after it."""
+        return self.pulse_at_s + self.observe_s
+
+
+#: chapter 6's protocol for DOB at Kf = 100: the friction kept, a tap that breaks it
+TAP = StabilityProtocol(pulse_n=3.0, pulse_s=0.02, observe_s=3.0, coulomb_n=None)
+#: a wall vibrates when the motion 2-3 s after the tap exceeds this RMS (m)
+VIBRATION_RMS_M = 2e-6
+
+
+def residual(x: np.ndarray, rate_hz: float, start_s: float, end_s: float) -> tuple[float, float]:
+    """(RMS about the slow trend in m, dominant frequency in Hz) of ``x`` over [start, end)."""
+    seg = np.asarray(x, dtype=np.float64)[int(start_s * rate_hz) : int(end_s * rate_hz)]
+    window = min(201, seg.size - (1 - seg.size % 2))
+    fast = seg - signal.savgol_filter(seg, window, 2)
+    freqs, power = signal.periodogram(fast, fs=rate_hz)
+    return float(np.sqrt(np.mean(fast * fast))), float(freqs[1 + int(np.argmax(power[1:]))])
+
+
+def tap_residual(
+    x: np.ndarray, rate_hz: float, protocol: StabilityProtocol = TAP
+) -> tuple[float, float]:
+    """``residual`` over the last second of a ``protocol`` session's record ``x`` (m)."""
+    end = protocol.duration_s
+    return residual(x, rate_hz, end - 1.0, end)
 
 
 @dataclass(frozen=True)
@@ -225,6 +257,8 @@ def law_for(controller: str, kf: float, max_force_n: float = 4.0) -> ImpedanceLa
 
 
 __all__ = [
+    "TAP",
+    "VIBRATION_RMS_M",
     "ObserverSettings",
     "StabilityPoint",
     "StabilityProtocol",
@@ -232,6 +266,8 @@ __all__ = [
     "growth_at",
     "law_for",
     "onset",
+    "residual",
     "sweep",
+    "tap_residual",
     "theory_bound",
 ]

@@ -20,7 +20,7 @@ DEFAULT_RANGE = "100:4000:100"
 def command(
     controller: str,
     kf: float,
-    observer_gain: float,
+    observer_gain: float | None,
     output_limit: float,
     stiffness: str,
     coulomb_n: float,
@@ -31,12 +31,13 @@ def command(
     """Run the sweep and print the table or JSON; raises on bad input."""
     ks = parse_range(stiffness, "--stiffness")
     nonnegative("--kf", kf)
-    positive("--observer-gain", observer_gain)
     nonnegative("--output-limit", output_limit)
     base = SessionConfig.from_yaml(resolve_config(config)) if config else SessionConfig()
+    gain = base.observer.gain if observer_gain is None else observer_gain
+    positive("--observer-gain", gain)
     base = base.replace(
         law=law_for(controller, kf, base.law.max_force_n),
-        observer=ObserverSettings(observer_gain, output_limit),
+        observer=ObserverSettings(gain, output_limit),
     )
     result = sweep(ks, base, StabilityProtocol(coulomb_n=coulomb_n), workers=workers)
     if as_json:
@@ -85,8 +86,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--observer-gain",
         type=float,
-        default=DEFAULT_GAIN,
-        help=f"observer gain c in N s/m (default {DEFAULT_GAIN})",
+        default=None,
+        help=f"observer gain c in N s/m (default: the --config's, else {DEFAULT_GAIN})",
     )
     p.add_argument(
         "--output-limit",

@@ -15,7 +15,10 @@ It explains what the thesis could not: the discrete observer answers sample k wi
 applied over [k-1, k) and a backward-difference velocity, so its estimate carries a piece of the
 command's own change, and with force feedback ``Kf`` that piece feeds the command back. The DOB
 loop is therefore *less* stable than CL with an ideal sensor (whose onset is the bound
-``2 b / (T (1 + Kf))``), increasingly so for a faster observer.
+``2 b / (T (1 + Kf))``), increasingly so for a faster observer. The piece is about
+``-(c T / 2 m) u_k`` in the estimate of sample k+1, so the loop has a real mode near
+``-Kf c T / (2 m)``: the command alternating its sign every period. ``chatter_gain`` is the
+observer gain at which that mode leaves the unit circle (about ``2 m / (Kf T)``; a lag lowers it).
 """
 
 from __future__ import annotations
@@ -28,6 +31,8 @@ from scipy.signal import cont2discrete
 from haptic_dob.validation import nonnegative, positive
 
 MODES = ("OL", "CL", "DOB")
+#: how far above 1 a spectral radius must be to count as unstable (rounding of a unit eigenvalue)
+MARGINAL = 1e-9
 
 
 def _plant(m: float, b: float, k_h: float, T: float, lag: float) -> tuple[np.ndarray, np.ndarray]:
@@ -112,10 +117,13 @@ def linear_onset(
     amplifier_lag_s: float = 0.0,
 ) -> float | None:
     """Smallest stiffness (N/m) at which the linear loop is unstable; 0 if it is at any; None if
-    stable up to ``k_max``. Found by bisection on the spectral radius (1 N/m resolution)."""
+    stable up to ``k_max``. Found by bisection on the spectral radius (1 N/m resolution); a
+    radius within ``MARGINAL`` of 1 is marginal, not unstable (a free mass, K = 0 without a grip,
+    has an eigenvalue of exactly 1, which rounding puts on either side)."""
 
     def unstable(k: float) -> bool:
-        return spectral_radius(k, kf, mode, gain, m, b, T, hand_stiffness, amplifier_lag_s) > 1.0
+        radius = spectral_radius(k, kf, mode, gain, m, b, T, hand_stiffness, amplifier_lag_s)
+        return radius > 1.0 + MARGINAL
 
     lo, hi = 0.0, 1.0
     if unstable(0.0):
@@ -127,4 +135,53 @@ def linear_onset(
     while hi - lo > 1.0:
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if unstable(mid) else (mid, hi)
+    return hi
+
+
+def sample_rate_mode(
+    stiffness: float,
+    kf: float,
+    gain: float,
+    m: float,
+    b: float,
+    T: float,
+    hand_stiffness: float = 0.0,
+    amplifier_lag_s: float = 0.0,
+) -> float:
+    """Magnitude of the DOB loop's negative real eigenvalue (the command alternating its sign
+    every period; > 1: it chatters at the sample rate), 0 if there is none."""
+    M = loop_map(stiffness, kf, "DOB", gain, m, b, T, hand_stiffness, amplifier_lag_s)
+    ev = np.linalg.eigvals(M)
+    real_negative = [abs(e.real) for e in ev if e.real < 0.0 and abs(e.imag) < 1e-9]
+    return max(real_negative, default=0.0)
+
+
+def chatter_gain(
+    kf: float,
+    m: float,
+    b: float,
+    T: float,
+    stiffness: float = 800.0,
+    hand_stiffness: float = 0.0,
+    amplifier_lag_s: float = 0.0,
+) -> float | None:
+    """The observer gain c (N s/m) above which DOB at ``kf`` chatters at the sample rate (its
+    sample-rate mode outside the unit circle), by bisection to 1e-4 relative; None if it does
+    not below ``50 m / T`` (the observer's pole ``exp(-c T / m)`` then 2e-22: settled within a
+    period). About ``2 m / (Kf T)`` without an amplifier lag."""
+    positive("kf", kf)
+    c_max = 50.0 * positive("m", m) / positive("T", T)
+
+    def chatters(c: float) -> bool:
+        mode = sample_rate_mode(stiffness, kf, c, m, b, T, hand_stiffness, amplifier_lag_s)
+        return mode > 1.0
+
+    lo, hi = 0.0, 2.0 * m / (kf * T)
+    while not chatters(hi):
+        if hi >= c_max:
+            return None
+        lo, hi = hi, min(hi * 2.0, c_max)
+    while hi - lo > 1e-4 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if chatters(mid) else (mid, hi)
     return hi

@@ -8,7 +8,8 @@ states by least squares, by the step method and by the thesis's step formulas; e
 model then predicts every run (a batch simulation of the model alone, under the same spring and
 input) and the prediction is set against the recorded positions. The plant's truth
 (``plant.*``, with stiction and an amplifier lag the model leaves out) is shown beside what was
-identified.
+identified. The configuration's observer model (the ``/**`` ``slide.*`` block) is the least-squares
+model of the 2.4 N bag to ``MODEL_DIGITS`` significant digits; a check says whether it still is.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from haptic_dob.bag.joints import read_joint
 from haptic_dob.control import ControlMode, ImpedanceLaw
 from haptic_dob.environment import VirtualWall
 from haptic_dob.excitation import Excitation
-from haptic_dob.identification import IdentificationError, SlideFit, identify
+from haptic_dob.identification import IdentificationError, JointRecord, SlideFit, identify
 from haptic_dob.models.slide import SlideParams
 from haptic_dob.runtime.params import values_of
 from haptic_sim.experiments.graph_runs import GraphRun, session_params
@@ -44,6 +45,8 @@ VERIFY = (
 RECORDED = ["joint_states", "ee_pose", "ee_twist", "wrench_measured", "/parameter_events"]
 METHODS = ("least_squares", "step", "thesis_step")
 TRACE_HZ = 200.0  # the traces kept in results.json for the figures
+#: significant digits of the identified model as the configuration states it
+MODEL_DIGITS = 4
 
 
 @dataclass(frozen=True)
@@ -101,6 +104,40 @@ def chapter4_runs(base_config: Path, _seed: int = 0, _quick: bool = False) -> li
         cell = Cell("ch4", "OL", 0.0, SPRING_N_PER_M)
         runs.append(GraphRun(run_name(e), params, cell, f"ch4 {e.label()} under the spring"))
     return runs
+
+
+def rounded(x: float, digits: int = MODEL_DIGITS) -> float:
+    """``x`` to ``digits`` significant digits."""
+    return float(f"{x:.{digits}g}")
+
+
+def stated_model(fit: SlideFit) -> tuple[float, float, float]:
+    """(m, c, Fc) of a fit as the configuration states them (``MODEL_DIGITS`` digits)."""
+    return rounded(fit.mass_kg), rounded(fit.viscous_n_s_per_m), rounded(fit.coulomb_n or 0.0)
+
+
+def identification_record(base_config: Path) -> JointRecord:
+    """The 2.4 N run's joint states from its session in batch (the lockstep graph's bag holds the
+    same samples, to the bit): encoder positions and the effort applied over [k-1, k)."""
+    run = chapter4_runs(base_config)[0]
+    cfg = SessionConfig.from_node_params(run.params)
+    res = run_session(cfg)
+    period_ns = round(1e9 / cfg.loop.rate_hz)
+    stamps = np.arange(res.q.size, dtype=np.int64) * period_ns
+    return JointRecord(stamps, res.q, res.effort, "slide")
+
+
+def model_check(fits: list[SlideFit], model: SlideParams) -> Check:
+    """Whether the configuration's observer model is the least-squares model of the 2.4 N bag."""
+    ls = next((f for f in fits if f.method == "least_squares"), None)
+    stated = (model.mass_kg, model.viscous_n_s_per_m, model.coulomb_n)
+    got = stated_model(ls) if ls is not None else None
+    return Check(
+        f"the configuration's observer model (m {stated[0]:g} kg, c {stated[1]:g} N s/m, Fc "
+        f"{stated[2]:g} N) is least squares on the 2.4 N bag to {MODEL_DIGITS} significant "
+        "digits" + ("" if got is None or got == stated else f" (found {got})"),
+        got == stated,
+    )
 
 
 def predicted_positions(fit: SlideFit, e: Excitation, base: SessionConfig) -> np.ndarray:
@@ -165,7 +202,8 @@ def ch4_result(rows: list[RunAnalysis], base: SessionConfig) -> Ch4Result:
                 )
         except ValueError as exc:  # the fitted model is no model (a negative friction...)
             failures.append(f"{fit.method}: its model predicts nothing: {exc}")
-    checks = ch4_checks(fits, base.device) + [Check(f, False) for f in failures]
+    checks = [*ch4_checks(fits, base.device), model_check(fits, base.model)]
+    checks += [Check(f, False) for f in failures]
     return Ch4Result(fits, predictions, measured, checks, failures)
 
 

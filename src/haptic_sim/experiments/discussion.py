@@ -7,7 +7,7 @@ the parts that were run (``parts.EXPERIMENTS``).
 from __future__ import annotations
 
 from haptic_sim.experiments import thesis
-from haptic_sim.experiments.dob import DobStudy
+from haptic_sim.experiments.dob import GRIPS, DobStudy, first_vibrating_with
 from haptic_sim.experiments.phantom import PhantomResult
 from haptic_sim.experiments.records import RunAnalysis
 from haptic_sim.experiments.results import bound
@@ -47,48 +47,93 @@ def ch7_notes(rows: list[RunAnalysis]) -> str:
     return (" ".join(notes) + "\n") if notes else ""
 
 
-def dob_discussion(d: DobStudy) -> str:
-    """What the grid shows, with its own numbers."""
-    slow, slow_nf = d.first_wall(2.0, 0.24), d.first_wall(2.0, 0.0)
-    fast = d.first_wall(41.6, 0.24)
-    l100 = next((r.dob_onset_n_per_m for r in d.linear if (r.kf, r.gain) == (100.0, 2.0)), None)
-    at_100 = [r for r in d.linear if r.kf == 100.0]
-    all_unstable = bool(at_100) and all(r.dob_onset_n_per_m == 0.0 for r in at_100)
+def _last_quiet(d: DobStudy, gain: float, coulomb_n: float) -> float | None:
+    """The stiffest wall below the first vibrating one of a grid row (N/m)."""
+    first = d.first_wall(gain, coulomb_n)
+    quiet = [
+        p.stiffness_n_per_m
+        for p in d.kick
+        if (p.gain, p.coulomb_n) == (gain, coulomb_n)
+        and not p.vibrates
+        and (first is None or p.stiffness_n_per_m < first)
+    ]
+    return max(quiet, default=None)
+
+
+def dob_discussion(d: DobStudy, gain: float) -> str:
+    """What the grid shows, with its own numbers; ``gain`` is the configuration's (N s/m)."""
+    at_100 = [r.dob_onset_n_per_m for r in d.linear if r.kf == 100.0]
     verdict = (
-        "unstable at any wall for every observer gain tried"
-        if all_unstable
-        else "unstable from a lower wall than CL's"
+        f"unstable from {max(o or 0.0 for o in at_100):.0f} N/m at most, for every observer gain "
+        "tried"
+        if at_100 and all(o is not None for o in at_100)
+        else "stable at some walls for some observer gains"
     )
-    bw = {g.gain: g.bandwidth_hz for g in d.bandwidth_vs_gain}
+    fc = max((p.coulomb_n for p in d.kick), default=0.0)
+    by_gain = ", ".join(
+        f"{fv.gain:g} N s/m: {fmt(fv.wall, 'g', 'none')}"
+        for fv in d.first_vibrating
+        if fv.coulomb_n == fc
+    )
+    chatter = d.chatter_at(100.0)
+    fast = sorted(
+        {fv.gain for fv in d.first_vibrating if chatter is not None and fv.gain > chatter}
+    )
+    fast_text = ", ".join(f"{g:g}" for g in fast) or "none of the grid's"
     return f"""\
 The force-feedback bound predicts about {bound("CL", 100.0, 1.272, 1000.0):.0f} N/m at Kf = 100,
 and the linear model of the sampled loop (the observer exactly as implemented) is worse still:
-the DOB loop at Kf = 100 is {verdict} (linear onset
-{fmt(l100, ".0f", "none")} N/m at c = 2). A linear instability need not be
-a vibration the hand feels, though: the loop is linear only while the command stays inside the
-actuator's 4 N, a band of 2 u_max / (Kf K) of position (0.1 mm at 800 N/m). Outside it the
-high-gain loop acts as a relay of bounded amplitude, and what happens then depends on what the
-linear model leaves out:
+the DOB loop at Kf = 100 is {verdict}. A linear instability need not be a vibration the hand
+feels, though: the loop is linear only while the command stays inside the actuator's 4 N, a band
+of 2 u_max / (Kf K) of position (0.1 mm at 800 N/m). Outside it the high-gain loop acts as a
+relay of bounded amplitude, and what happens then depends on what the linear model leaves out
+(chapter 6's tap, in batch):
 
-- **Coulomb friction with a slow observer stops it.** With c = 2 N s/m (the one gain the thesis
-  states, for the PHANToM in 5.2) and the slide's 0.24 N of Coulomb friction, a kick dies out and
-  the slide sticks where the wall and the hand balance; the first wall that keeps vibrating is
-  {fmt(slow, "g", "none")} N/m, as in the thesis (3200 N/m).
-- **Without friction it does not.** The same observer without Coulomb friction vibrates from
-  {fmt(slow_nf, "g", "none")} N/m: the relay chatter has nothing to catch it.
-- **A fast observer does not let it rest.** With c = 41.6 N s/m (the gain that gives the
-  chapter-7 DOB bandwidth; time constant {1000 * 0.416 / 41.6:.0f} ms) the first vibrating wall
-  is {fmt(fast, "g", "none")} N/m even with friction, with a slower oscillation (the grid's
-  frequencies): the estimate is fast enough to see the stick-slip transitions, and Kf = 100
-  feeds them back (a reading of the grid, not a separate experiment).
+- **Friction stops it.** With the plant's friction and the configuration's observer (c =
+  {gain:g} N s/m) a tap dies out and the slide sticks where the wall and the hand balance, up to
+  {fmt(_last_quiet(d, gain, fc), "g", "none")} N/m; the first wall that keeps vibrating is
+  {fmt(d.first_wall(gain, fc), "g", "none")} N/m (the thesis: quiet at 2400, vibrating at 3200
+  N/m). Without Coulomb friction the same observer vibrates from
+  {fmt(d.first_wall(gain, 0.0), "g", "none")} N/m: the relay has nothing to catch it.
+- **A faster observer holds a stiffer wall, up to the gain where it chatters.** The first wall
+  that keeps vibrating with friction, per observer gain: {by_gain}. Above about 2 m / (Kf T)
+  ({fmt(chatter, ".1f")} N s/m at Kf = 100 with the amplifier lag) the estimate's share of the
+  last command, fed back Kf times, alternates the command's sign every period (the linear model's
+  sample-rate mode): with {fast_text} N s/m the slide hunts by micrometres at the softer walls or
+  vibrates at all of them.
 
 So the mechanism the thesis guessed at (dissipation over a longer period) is, in the simulator,
-friction stopping a saturated relay oscillation that a slow observer does not re-excite. The
-price is transparency: with c = 2 the DOB Kf = 1 bandwidth at 800 N/m is
-{fmt(bw.get(2.0))} Hz, with c = 41.6 it is {fmt(bw.get(41.6))} Hz (thesis: 5.1 Hz). No single
-observer gain reproduces both chapters; the thesis does not state the slide's gain, and it may
-well have differed between the two experiments.
+friction stopping a saturated relay oscillation, and the observer's gain sets how stiff a wall it
+holds. {_best(d, chatter, fc)} {_hands(d)}
 """
+
+
+def _hands(d: DobStudy) -> str:
+    """What the hand changes (the grip table), from the results."""
+    walls = {g.name: first_vibrating_with(d.grips, g.name) for g in GRIPS}
+    if len(walls) < 2 or not d.grips:
+        return ""
+    light, bench = (walls[g.name] for g in GRIPS)
+    top = max(p.stiffness_n_per_m for p in d.grips)
+    return (
+        f"The hand decides as much: with chapter 6's light grip the first wall that keeps "
+        f"vibrating is {fmt(light, 'g', 'none')} N/m, with a hand as on the bench (0.1 kg, "
+        f"300 N/m, 5 N s/m) {fmt(bench, 'g', f'none up to {top:g}')} N/m; the thesis does not "
+        "say how its user held the handle."
+    )
+
+
+def _best(d: DobStudy, chatter: float | None, fc: float) -> str:
+    """Which gain below the chatter gain holds the stiffest wall in the grid (with friction)."""
+    calm = [fv for fv in d.first_vibrating if fv.coulomb_n == fc]
+    calm = [fv for fv in calm if chatter is None or fv.gain < chatter]
+    if not calm:
+        return ""
+    best = max(calm, key=lambda fv: (fv.wall is None, fv.wall or 0.0, fv.gain))
+    return (
+        f"Of the grid's gains below the chatter gain, c = {best.gain:g} N s/m holds the "
+        f"stiffest wall (first vibrating {fmt(best.wall, 'g', 'none')} N/m)."
+    )
 
 
 def phantom_text(p: PhantomResult) -> str:
@@ -112,35 +157,39 @@ def phantom_text(p: PhantomResult) -> str:
 
 
 # --- where the simulation differs from the thesis ----------------------------------------------
-OBSERVER_IS_THE_PLANT = (
-    "- **The observer's model is nearly the plant.** The thesis (7.3.3.1) traces the "
+OBSERVER_MODEL = (
+    "- **The observer's model is the identified one.** The thesis (7.3.3.1) traces the "
     "high-gain DOB's lower bandwidth (Kf = 25) to modelling errors that force feedback "
-    "amplifies (friction underestimated at low speed, overshoot at high frequency). Here "
-    "the observer's model misses only the simulated plant's stiction and its amplifier lag "
-    "(see Configuration), so a higher Kf widens the band instead, up to "
-    "`--fmax`. Leaving Coulomb friction out of the observer's model moves the Kf = 25 "
-    "cells the thesis's way (narrower band, larger error; the DOB section's last "
-    "table) without reaching its 2.9-3.9 Hz."
+    "amplifies (friction underestimated at low speed, overshoot at high frequency). Here the "
+    "observer's model is least squares on chapter 4's bag: within 1 % of the plant's mass, "
+    "viscous and Coulomb friction, missing its stiction and its amplifier lag (see the "
+    "configuration). What narrows the Kf = 25 band here is the observer's lag: for a large Kf "
+    "the rendered impedance rises past +3 dB near the observer's corner c / (2 pi m) (the "
+    "sweeps section). Leaving Coulomb friction out of the observer's model moves the Kf = 25 "
+    "cells further (the DOB section's last table)."
 )
 HAND_IS_A_MODEL = (
     "- **The hand is a model.** The thesis's users moved the handle themselves; here a "
     "seeded semi-random reference (0.05-10 Hz) drives a mass-spring-damper hand, the "
-    "same for every controller. The thesis's OL bandwidth of 0.6 Hz at 2400 N/m, out of "
-    "line with its own 800 and 1600 N/m cells, is not reproduced: the simulated OL band "
-    "keeps growing with the wall as a mass-damper's does. At 80 N/m the force swing is "
-    "small against friction and the hand's own dynamics, and coherence is low."
+    "same for every controller; another seed moves some cells by more than the 15 % "
+    "criterion (the sweeps section's table for other seeds)."
 )
 ONSETS_FROM_A_PROTOCOL = (
     "- **Onsets come from a protocol, not a user.** The thesis's onsets are the lowest of "
-    "four walls at which a user could induce sustained vibration; here the growth rate "
-    "of a pulse response is interpolated to its zero crossing, with Coulomb friction off "
-    "and a light grip (the worst case the passivity bound describes), so the OL and CL "
-    "onsets are read between the thesis's coarse walls."
+    "four walls at which a user could induce sustained vibration. Here the OL and CL onsets "
+    "are the zero crossing of a pulse response's growth rate with Coulomb friction off (the "
+    "premise of the passivity bounds the thesis compared them with), read between the thesis's "
+    "coarse walls: with the plant's friction neither keeps any vibration after a tap (the "
+    "tap table), since 0.24 N of Coulomb friction outweighs the sampled wall's small negative "
+    "damping at any amplitude that keeps contact. DOB at Kf = 100, unstable at every wall "
+    "without friction, is tapped with the plant's friction kept."
 )
-OBSERVER_GAIN_NOT_IN_THESIS = (
-    "- **The slide's observer gain is not in the thesis.** c = 41.6 N s/m (m/c = 10 ms) "
-    "gives the chapter-7 DOB bandwidth; the chapter-6 DOB result (quiet to 3200 N/m at "
-    "Kf = 100) needs a slow observer and friction (the DOB section)."
+OBSERVER_GAIN = (
+    "- **The slide's observer gain is not in the thesis.** One gain serves every chapter: "
+    "the fastest whole one with which DOB at the thesis's largest Kf (100) does not chatter "
+    "at the sample rate (the DOB section). Chapter 7's low-gain DOB (Kf = 1) would need a "
+    "faster observer to follow the thesis's band, which at Kf = 25 and 100 chatters (the "
+    "sweeps section)."
 )
 
 
@@ -158,4 +207,4 @@ def ch7_differences(rows: list[RunAnalysis]) -> list[str]:
             f"- **Bandwidths more than {DEPARTURE:.0%} from Table 7.1** (Hz, simulation vs "
             "thesis): " + ", ".join(far) + "."
         )
-    return [*out, OBSERVER_IS_THE_PLANT, HAND_IS_A_MODEL]
+    return [*out, OBSERVER_MODEL, HAND_IS_A_MODEL]

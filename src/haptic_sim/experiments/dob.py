@@ -1,89 +1,55 @@
-"""Why the thesis's DOB wall (Kf = 100) stayed quiet to 3200 N/m: the mechanism, with the knobs.
+"""Why the thesis's DOB wall (Kf = 100) kept quiet to 2400 N/m: the mechanism, with its knobs.
 
 The force-feedback bound ``2 b / (T (1 + Kf))`` is 25 N/m at Kf = 100, and the linear loop model
-(``haptic_dob.analysis.linear_loop``) says the DOB loop is even less stable than that. Yet the
-thesis saw no sustained vibration below 3200 N/m. The study here runs the slide in batch with a
-hand as on the bench (``KickProtocol``: a 0.1 kg hand holding the handle through a 300 N/m grip
-with 5 N s/m, pushing 1.5 N into the wall, kicked with 3 N for 20 ms) and varies what the linear
-model leaves out:
+(``haptic_dob.analysis.linear_loop``) says the DOB loop is unstable at every wall. Yet the thesis
+saw sustained vibration only at 3200 N/m. Chapter 6's tap protocol (``haptic_sim.stability.TAP``:
+the light grip, the configuration's plant and model with their friction, a 3 N x 20 ms tap) finds
+the first wall that keeps vibrating through the graph; the study here repeats it in batch and
+varies what the linear model leaves out or what it cannot decide:
 
 - the actuator saturation (4 N) and the observer's output limit (4 N): the high-gain loop is
   linear only in a band of ``2 u_max / (Kf K)`` of position around equilibrium, so a growing
-  oscillation soon saturates and the loop acts as a relay (bang-bang) of bounded amplitude;
-- Coulomb friction (0.24 N): a relay chatter of small amplitude sticks, and the slide stays where
-  the wall's push and the hand balance, the observer then reading the steady hand force;
-- the observer gain ``c``: a slow observer (c = 2 N s/m, the only gain the thesis states, for the
-  PHANToM) leaves the stuck state alone; a fast one (41.6 N s/m, tuned for the chapter-7 bandwidth)
-  keeps re-exciting it.
+  oscillation soon saturates and the loop acts as a relay of bounded amplitude;
+- Coulomb friction (the plant's and the model's, or none): a relay chatter of small amplitude
+  sticks, and the slide stays where the wall's push and the hand balance;
+- the observer gain ``c``, the configuration's among others: the faster the observer, the stiffer
+  the wall it keeps quiet, up to the gain above which the estimate's share of the last command
+  makes the loop chatter at the sample rate (``chatter_gain``, about ``2 m / (Kf T)``).
 
-``residual`` measures what is left 2 to 3 s after the kick (RMS of the depth about its slow
-trend, and its dominant frequency); a wall vibrates when that exceeds ``VIBRATION_RMS_M``.
+``residual`` (``haptic_sim.stability``) measures what is left 2 to 3 s after the tap; a wall
+vibrates when that exceeds ``VIBRATION_RMS_M``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from concurrent.futures import Executor
 from dataclasses import dataclass
 from typing import ClassVar
 
-import numpy as np
-from scipy import signal
-
-from haptic_dob.analysis.linear_loop import linear_onset
-from haptic_dob.observer import ObserverSettings
+from haptic_dob.analysis.linear_loop import chatter_gain, linear_onset
 from haptic_sim.hand import reference_for_force
 from haptic_sim.session import SessionConfig, SessionResult, run_session
-from haptic_sim.stability import StabilityProtocol, law_for
+from haptic_sim.stability import TAP, VIBRATION_RMS_M, law_for, tap_residual
 
-#: a wall vibrates when the residual motion 2-3 s after the kick exceeds this RMS (m)
-VIBRATION_RMS_M = 2e-6
-WALLS = [400.0, 800.0, 1600.0, 2400.0, 3200.0, 4000.0]
-#: (observer gain c in N s/m, Coulomb friction in N) combinations of the grid
-KNOBS = [(2.0, 0.24), (2.0, 0.0), (41.6, 0.24), (41.6, 0.0)]
-GAINS_FOR_BANDWIDTH = [2.0, 5.0, 10.0, 20.0, 41.6]
-#: the linear model's table: observer gains c (N s/m) for each Kf
-LINEAR_GAINS = [2.0, 10.0, 41.6]
+WALLS = [800.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 4000.0]
+#: observer gains c (N s/m) of the grid, beside the configuration's
+GAINS = [2.0, 4.0, 10.0, 41.6]
+#: the linear model's table: Kf values (each with the grid's gains)
 LINEAR_KFS = [1.0, 2.0, 25.0, 100.0]
 #: the wall (N/m) of the stick-or-chatter traces
 TRACES_WALL = 1600.0
 
 
-@dataclass(frozen=True)
-class KickProtocol:
-    """A hand as on the bench holds the handle against the wall and is kicked once."""
-
-    push_n: float = 1.5
-    grip_n_per_m: float = 300.0
-    hand_mass_kg: float = 0.1
-    hand_damping_n_s_per_m: float = 5.0
-    kick_n: float = 3.0
-    kick_s: float = 0.02
-    kick_at_s: float = 1.5
-    observe_s: float = 3.0
-
-    def session(
-        self, base: SessionConfig, stiffness: float, gain: float, coulomb_n: float
-    ) -> SessionConfig:
-        """The batch session at one wall, observer gain (N s/m) and Coulomb friction (N)."""
-        onset = StabilityProtocol(
-            push_n=self.push_n,
-            grip_n_per_m=self.grip_n_per_m,
-            pulse_n=self.kick_n,
-            pulse_s=self.kick_s,
-            pulse_at_s=self.kick_at_s,
-            observe_s=self.observe_s,
-            coulomb_n=coulomb_n,
-        )
-        with_gain = base.replace(observer=ObserverSettings(gain, base.observer.output_limit))
-        return onset.session(with_gain, stiffness).replace(
-            hand__mass_kg=self.hand_mass_kg,
-            hand__damping_n_s_per_m=self.hand_damping_n_s_per_m,
-        )
+def gains_of(base: SessionConfig) -> list[float]:
+    """The grid's observer gains with the configuration's, ascending."""
+    return sorted({*GAINS, base.observer.gain})
 
 
 @dataclass(frozen=True)
 class KickPoint:
-    """The residual vibration of one (wall, c, Coulomb) cell."""
+    """The residual vibration of one (wall, c, friction) cell after the tap; ``coulomb_n`` is the
+    plant's Coulomb friction (0: friction off in the plant and the model)."""
 
     stiffness_n_per_m: float
     gain: float
@@ -95,7 +61,7 @@ class KickPoint:
 
     @property
     def vibrates(self) -> bool:
-        """True when the motion is still there 2-3 s after the kick."""
+        """True when the motion is still there 2-3 s after the tap."""
         return self.residual_rms_m > VIBRATION_RMS_M
 
 
@@ -119,14 +85,13 @@ class LinearOnset:
 
 
 @dataclass(frozen=True)
-class GainBandwidth:
-    """DOB transparency (batch, the chapter-7 hand) at one observer gain c (N s/m)."""
+class ChatterGain:
+    """The observer gain (N s/m) above which DOB at ``kf`` chatters at the sample rate, on the
+    simulated plant with its amplifier lag and without (the ``2 m / (Kf T)`` of the text)."""
 
-    gain: float
     kf: float
-    wall: float
-    bandwidth_hz: float | None
-    impedance_error_pct: float | None
+    gain: float | None
+    gain_without_lag: float | None
 
 
 @dataclass(frozen=True)
@@ -141,15 +106,50 @@ class MismatchCell:
 
 
 @dataclass(frozen=True)
+class Grip:
+    """A hand holding the handle for the tap: its mass (kg), grip stiffness (N/m) and damping
+    (N s/m)."""
+
+    name: str
+    mass_kg: float
+    stiffness_n_per_m: float
+    damping_n_s_per_m: float
+
+
+#: chapter 6's light grip, and a hand as on the bench
+GRIPS = (Grip("light grip", 0.0, 20.0, 0.0), Grip("bench hand", 0.1, 300.0, 5.0))
+
+
+@dataclass(frozen=True)
+class GripPoint:
+    """The residual vibration after the tap at one wall with one hand (the configuration's
+    observer and friction)."""
+
+    grip: str
+    stiffness_n_per_m: float
+    residual_rms_m: float
+    frequency_hz: float
+
+    JSON_DERIVED: ClassVar[tuple[str, ...]] = ("vibrates",)
+
+    @property
+    def vibrates(self) -> bool:
+        """True when the motion is still there 2-3 s after the tap."""
+        return self.residual_rms_m > VIBRATION_RMS_M
+
+
+@dataclass(frozen=True)
 class DobStudy:
-    """The dob part's result: the kick grid, its first vibrating walls, the linear model, and
-    the transparency against the observer gain and with a mismatched observer model."""
+    """The dob part's result: the tap grid and its first vibrating walls, the linear model's
+    onsets and chatter gains, the transparency with a mismatched observer model, and the tap
+    with another hand."""
 
     kick: list[KickPoint]
     first_vibrating: list[FirstVibrating]
     linear: list[LinearOnset]
-    bandwidth_vs_gain: list[GainBandwidth]
+    chatter: list[ChatterGain]
     model_mismatch: list[MismatchCell]
+    grips: list[GripPoint]
 
     def first_wall(self, gain: float, coulomb_n: float) -> float | None:
         """The first vibrating wall (N/m) of one (c, Coulomb) row; None if none or not run."""
@@ -158,48 +158,50 @@ class DobStudy:
             None,
         )
 
-
-def residual(x: np.ndarray, rate_hz: float, start_s: float, end_s: float) -> tuple[float, float]:
-    """(RMS about the slow trend in m, dominant frequency in Hz) of ``x`` over [start, end)."""
-    seg = x[int(start_s * rate_hz) : int(end_s * rate_hz)]
-    window = min(201, seg.size - (1 - seg.size % 2))
-    fast = seg - signal.savgol_filter(seg, window, 2)
-    freqs, power = signal.periodogram(fast, fs=rate_hz)
-    return float(np.sqrt(np.mean(fast * fast))), float(freqs[1 + int(np.argmax(power[1:]))])
+    def chatter_at(self, kf: float) -> float | None:
+        """The chatter gain (N s/m, with the amplifier lag) at ``kf``; None if not computed."""
+        return next((c.gain for c in self.chatter if c.kf == kf), None)
 
 
-def kick_point(
-    protocol: KickProtocol,
-    base: SessionConfig,
-    stiffness: float,
-    gain: float,
-    coulomb_n: float,
-) -> KickPoint:
-    """Run one cell (DOB, the base's Kf) and measure what is left of the kick."""
-    cfg = protocol.session(base, stiffness, gain, coulomb_n)
-    res = run_session(cfg)
-    end = protocol.kick_at_s + protocol.observe_s
-    rms, freq = residual(res.x_true, cfg.loop.rate_hz, end - 1.0, end)
-    return KickPoint(stiffness, gain, coulomb_n, rms, freq)
+def tapped(base: SessionConfig, stiffness: float, gain: float, friction: bool) -> SessionConfig:
+    """Chapter 6's tap session at one wall with observer gain ``gain`` (N s/m), the
+    configuration's friction kept or (``friction`` False) off in the plant and the model."""
+    protocol = TAP if friction else dataclasses.replace(TAP, coulomb_n=0.0)
+    return protocol.session(base.replace(observer__gain=gain), stiffness)
+
+
+def kick_point(base: SessionConfig, stiffness: float, gain: float, friction: bool) -> KickPoint:
+    """Run one cell (DOB, the base's Kf) and measure what is left of the tap."""
+    cfg = tapped(base, stiffness, gain, friction)
+    rms, freq = tap_residual(run_session(cfg).q, cfg.loop.rate_hz)
+    return KickPoint(stiffness, gain, cfg.device.coulomb_n, rms, freq)
+
+
+def grip_point(base: SessionConfig, stiffness: float, grip: Grip) -> GripPoint:
+    """The tap at one wall with ``grip`` holding the handle (DOB, the base's Kf, gain, friction)."""
+    cfg = tapped(base, stiffness, base.observer.gain, True).replace(
+        hand__mass_kg=grip.mass_kg,
+        hand__stiffness_n_per_m=grip.stiffness_n_per_m,
+        hand__damping_n_s_per_m=grip.damping_n_s_per_m,
+        hand__offset_m=TAP.push_n * (1.0 / stiffness + 1.0 / grip.stiffness_n_per_m),
+    )
+    rms, freq = tap_residual(run_session(cfg).q, cfg.loop.rate_hz)
+    return GripPoint(grip.name, stiffness, rms, freq)
 
 
 def kick_grid(
     base: SessionConfig,
     kf: float = 100.0,
     walls: list[float] | None = None,
-    knobs: list[tuple[float, float]] | None = None,
+    gains: list[float] | None = None,
     executor: Executor | None = None,
 ) -> list[KickPoint]:
-    """DOB at ``kf`` over walls x (c, Coulomb)."""
+    """DOB at ``kf`` over walls x gains x (friction kept, off)."""
     dob = base.replace(law=law_for("DOB", kf, base.law.max_force_n))
-    cells = [(k, c, fc) for c, fc in (knobs or KNOBS) for k in (walls or WALLS)]
-    args = (
-        [KickProtocol()] * len(cells),
-        [dob] * len(cells),
-        [k for k, _, _ in cells],
-        [c for _, c, _ in cells],
-        [fc for _, _, fc in cells],
-    )
+    cells = [
+        (k, c, f) for c in (gains or gains_of(base)) for f in (True, False) for k in walls or WALLS
+    ]
+    args = ([dob] * len(cells), *(list(x) for x in zip(*cells, strict=True)))
     if executor is None:
         return [kick_point(*a) for a in zip(*args, strict=True)]
     return list(executor.map(kick_point, *args))
@@ -229,32 +231,18 @@ def linear_onsets(base: SessionConfig, gains: list[float], kfs: list[float]) -> 
     ]
 
 
-def bandwidth_vs_gain(
-    base: SessionConfig,
-    gains: list[float],
-    kf: float = 1.0,
-    wall: float = 800.0,
-    seed: int = 0,
-    duration_s: float = 40.0,
-    executor: Executor | None = None,
-) -> list[GainBandwidth]:
-    """DOB transparency bandwidth (Hz) at one wall against the observer gain (batch, ch. 7 hand)."""
-    offset, amplitude = reference_for_force(wall, base.hand.stiffness_n_per_m)
-    cfgs = [
-        base.replace(
-            law=law_for("DOB", kf, base.law.max_force_n),
-            observer=ObserverSettings(c, base.observer.output_limit),
-            wall__stiffness_n_per_m=wall,
-            hand__offset_m=offset,
-            hand__amplitude_m=amplitude,
-            loop__seed=seed,
-            loop__duration_s=duration_s,
-        )
-        for c in gains
-    ]
-    results = list(executor.map(_summary, cfgs)) if executor else [_summary(c) for c in cfgs]
+def chatter_gains(base: SessionConfig, kfs: list[float]) -> list[ChatterGain]:
+    """The gain above which DOB chatters at the sample rate, per Kf: the observer's model mass
+    and viscous friction (what its estimate divides by), the plant's amplifier lag."""
+    m, b = base.model.mass_kg, base.model.viscous_n_s_per_m
+    T, lag = 1.0 / base.loop.rate_hz, base.device.amplifier_lag_s
     return [
-        GainBandwidth(c, kf, wall, bw, err) for c, (bw, err) in zip(gains, results, strict=True)
+        ChatterGain(
+            kf,
+            chatter_gain(kf, m, b, T, amplifier_lag_s=lag),
+            chatter_gain(kf, m, b, T),
+        )
+        for kf in kfs
     ]
 
 
@@ -304,21 +292,35 @@ def _summary(cfg: SessionConfig) -> tuple[float | None, float | None]:
 
 
 def traces(base: SessionConfig, stiffness: float, kf: float = 100.0) -> dict[str, SessionResult]:
-    """The kick at one wall with c = 2: with Coulomb friction (sticks) and without (chatters)."""
+    """The tap at one wall with the configuration's gain: with friction (sticks), without
+    (chatters)."""
     dob = base.replace(law=law_for("DOB", kf, base.law.max_force_n))
-    p = KickProtocol()
+    c = base.observer.gain
     return {
-        f"Coulomb {fc:g} N": run_session(p.session(dob, stiffness, 2.0, fc)) for fc in (0.24, 0.0)
+        name: run_session(tapped(dob, stiffness, c, friction))
+        for name, friction in (("the plant's friction", True), ("no Coulomb friction", False))
     }
 
 
 def study(base: SessionConfig, executor: Executor | None = None) -> DobStudy:
     """The whole mechanism study (batch; ``executor``: a shared process pool)."""
     kick = kick_grid(base, executor=executor)
+    rows = sorted({(p.gain, p.coulomb_n) for p in kick})
+    dob = base.replace(law=law_for("DOB", 100.0, base.law.max_force_n))
+    cells = [(w, g) for g in GRIPS for w in WALLS]
+    args = ([dob] * len(cells), [w for w, _ in cells], [g for _, g in cells])
+    grips = list(executor.map(grip_point, *args)) if executor else list(map(grip_point, *args))
     return DobStudy(
         kick,
-        [FirstVibrating(c, fc, first_vibrating(kick, c, fc)) for c, fc in KNOBS],
-        linear_onsets(base, LINEAR_GAINS, LINEAR_KFS),
-        bandwidth_vs_gain(base, GAINS_FOR_BANDWIDTH, executor=executor),
+        [FirstVibrating(c, fc, first_vibrating(kick, c, fc)) for c, fc in rows],
+        linear_onsets(base, gains_of(base), LINEAR_KFS),
+        chatter_gains(base, LINEAR_KFS),
         model_mismatch(base, executor=executor),
+        grips,
     )
+
+
+def first_vibrating_with(points: list[GripPoint], grip: str) -> float | None:
+    """The lowest wall (N/m) that keeps vibrating after the tap with one hand; None if none."""
+    row = sorted((p for p in points if p.grip == grip), key=lambda p: p.stiffness_n_per_m)
+    return next((p.stiffness_n_per_m for p in row if p.vibrates), None)

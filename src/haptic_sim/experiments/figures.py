@@ -10,11 +10,12 @@ from typing import Any
 import numpy as np
 
 from haptic_sim.experiments import thesis
-from haptic_sim.experiments.dob import VIBRATION_RMS_M, KickPoint
+from haptic_sim.experiments.dob import KickPoint
 from haptic_sim.experiments.records import GraphOnset, RunAnalysis, label
 from haptic_sim.experiments.results import bound, ch7_grid
 from haptic_sim.experiments.zwidth import K_MAX, K_MIN, MapPoint
 from haptic_sim.session import SessionResult
+from haptic_sim.stability import VIBRATION_RMS_M
 
 
 def pyplot() -> Any:
@@ -174,7 +175,7 @@ def plot_kick_grid(points: list[KickPoint], path: Path) -> None:
         )
     ax.axhline(VIBRATION_RMS_M * 1e6, color="k", ls=":", lw=0.8, label="vibration threshold")
     ax.set_xlabel("wall stiffness (N/m)")
-    ax.set_ylabel("residual motion 2-3 s after the kick (um RMS)")
+    ax.set_ylabel("residual motion 2-3 s after the tap (um RMS)")
     ax.set_title("DOB Kf = 100 on the slide: what stops the vibration")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
@@ -182,7 +183,7 @@ def plot_kick_grid(points: list[KickPoint], path: Path) -> None:
 
 
 def plot_kick_traces(runs: dict[str, SessionResult], stiffness: float, path: Path) -> None:
-    """Depth and command around the kick, with and without Coulomb friction (runs by name)."""
+    """Depth and command around the tap, with and without Coulomb friction (runs by name)."""
     plt = pyplot()
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
     for name, r in runs.items():
@@ -191,7 +192,7 @@ def plot_kick_traces(runs: dict[str, SessionResult], stiffness: float, path: Pat
     ax1.set_ylabel("position (mm)")
     ax2.set_ylabel("applied effort (N)")
     ax2.set_xlabel("time (s)")
-    ax1.set_title(f"DOB Kf = 100, c = 2 N s/m, {stiffness:g} N/m wall: the kick at 1.5 s")
+    ax1.set_title(f"DOB Kf = 100, {stiffness:g} N/m wall: the tap at 1.5 s")
     ax1.legend(fontsize=8)
     for ax in (ax1, ax2):
         ax.grid(True, alpha=0.3)

@@ -7,10 +7,14 @@ controller meets the same hand). The hand's push and swing follow the wall
 controller subscribes only to its own mode's input; the recorder records what the analysis reads.
 The quick variant (the demo) runs OL, CL Kf = 2 and DOB Kf = 1 at 800 N/m for 20 s.
 
-Chapter 6 (vibration onset, through the graph): the push-and-hold protocol of ``haptic-stability``
-(Coulomb friction off, a light 20 N/m grip, a 0.5 N x 5 ms pulse), for OL, CL with Kf = 2 and DOB
-with Kf = 100 over the thesis's walls (800 to 3200 N/m) plus points that bracket the OL and CL
-bounds, 4 s each.
+Chapter 6 (vibration onset, through the graph), the thesis's user trying to provoke vibration:
+a light 20 N/m grip pushing 1 N into the wall, 4-4.5 s per wall, in two protocols of
+``haptic_sim.stability``. The linear one (a 0.5 N x 5 ms pulse, Coulomb friction off in the plant
+and in the model: the premise of the passivity bounds the thesis compares its OL and CL onsets
+with) for OL and CL with Kf = 2 over the thesis's walls plus points that bracket their bounds, and
+DOB with Kf = 100 at two walls (linearly unstable at every wall). The tap (``TAP``: the
+configuration's plant and model as they are, a 3 N x 20 ms tap) for all three: OL and CL at
+their thesis walls (with friction, no wall keeps vibrating), DOB at the thesis's walls and between.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ from haptic_sim.experiments import thesis
 from haptic_sim.experiments.graph_runs import GraphRun, session_params
 from haptic_sim.experiments.records import Cell, label
 from haptic_sim.hand import reference_for_force
-from haptic_sim.stability import StabilityProtocol
+from haptic_sim.stability import TAP, StabilityProtocol
 
 CH7_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0), ("DOB", 25.0)]
 CH7_WALLS: list[float] = list(thesis.WALLS)
@@ -30,12 +34,22 @@ QUICK_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 
 QUICK_WALLS: list[float] = [800.0]
 QUICK_DURATION_S = 20.0
 CH6_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 100.0)]
-#: the thesis's walls (800-3200 N/m) and points around the OL and CL bounds (2544, 848 N/m)
+#: the linear protocol: the thesis's walls (800-3200 N/m) and points around the OL and CL bounds
+#: (2544, 848 N/m); DOB at two (unstable at every wall)
 CH6_WALLS: dict[str, list[float]] = {
     "OL": [800.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0],
     "CL": [600.0, 800.0, 900.0, 1000.0, 1200.0, 1600.0, 2400.0, 3200.0],
-    "DOB": [800.0, 1600.0, 2400.0, 3200.0],
+    "DOB": [800.0, 3200.0],
 }
+#: the tap with the configuration's friction: OL and CL at their thesis walls and the last one,
+#: DOB at the thesis's walls (its onset 3200 N/m) and between
+CH6_TAP_WALLS: dict[str, list[float]] = {
+    "OL": [2400.0, 3200.0],
+    "CL": [800.0, 3200.0],
+    "DOB": [800.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 3600.0],
+}
+#: the parts of the two protocols' cells (the tap's runs and rows are told apart by it)
+CH6_PARTS = {"linear": "ch6", "tap": "ch6tap"}
 RECORDED = ["ee_pose", "ee_twist", "wrench_measured", "/parameter_events"]
 
 
@@ -97,34 +111,42 @@ def chapter6_runs(
     base_config: Path,
     controllers: list[tuple[str, float]] | None = None,
     walls: dict[str, list[float]] | None = None,
+    protocol: StabilityProtocol | None = None,
+    part: str = CH6_PARTS["linear"],
 ) -> list[GraphRun]:
-    """The onset protocol's sessions as graph runs."""
-    p = StabilityProtocol()
+    """One protocol's sessions as graph runs (the linear one by default)."""
+    p = protocol or StabilityProtocol()
+    friction: dict[str, dict[str, Any]] = {}
+    if p.coulomb_n is not None:  # the assumed model's and the plant's
+        friction = {"/**": {"slide.coulomb_n": p.coulomb_n}}
     runs = []
     for mode, kf in controllers or CH6_CONTROLLERS:
         for wall in (walls or CH6_WALLS)[mode]:
+            device: dict[str, Any] = {
+                "duration_s": p.duration_s,
+                "hand.behaviour": "push_hold",
+                "hand.mass_kg": 0.0,
+                "hand.stiffness_n_per_m": p.grip_n_per_m,
+                "hand.damping_n_s_per_m": 0.0,
+                "hand.offset_m": p.push_n * (1.0 / wall + 1.0 / p.grip_n_per_m),
+                "hand.amplitude_m": 0.0,
+                "hand.ramp_s": p.ramp_s,
+                "hand.perturbation_n": p.pulse_n,
+                "hand.perturbation_at_s": p.pulse_at_s,
+                "hand.perturbation_s": p.pulse_s,
+            }
+            if p.coulomb_n is not None:
+                device["plant.coulomb_n"] = p.coulomb_n
             extra: dict[str, dict[str, Any]] = {
-                "/**": {"slide.coulomb_n": p.coulomb_n},  # the assumed model's
-                "device_node": {
-                    "plant.coulomb_n": p.coulomb_n,  # and the plant's
-                    "duration_s": p.pulse_at_s + p.observe_s,
-                    "hand.behaviour": "push_hold",
-                    "hand.mass_kg": 0.0,
-                    "hand.stiffness_n_per_m": p.grip_n_per_m,
-                    "hand.damping_n_s_per_m": 0.0,
-                    "hand.offset_m": p.push_n * (1.0 / wall + 1.0 / p.grip_n_per_m),
-                    "hand.amplitude_m": 0.0,
-                    "hand.ramp_s": p.ramp_s,
-                    "hand.perturbation_n": p.pulse_n,
-                    "hand.perturbation_at_s": p.pulse_at_s,
-                    "hand.perturbation_s": p.pulse_s,
-                },
+                **friction,
+                "device_node": device,
                 "environment_node": {"stiffness_n_per_m": wall},
             }
-            runs.append(_run(base_config, Cell("ch6", mode, kf, wall), extra))
+            runs.append(_run(base_config, Cell(part, mode, kf, wall), extra))
     return runs
 
 
 def chapter6_plan(base_config: Path, _seed: int, _quick: bool) -> list[GraphRun]:
-    """Chapter 6's runs (the hand holds still: no seed; no quick variant)."""
-    return chapter6_runs(base_config)
+    """Chapter 6's runs, both protocols (the hand holds still: no seed; no quick variant)."""
+    tap = chapter6_runs(base_config, walls=CH6_TAP_WALLS, protocol=TAP, part=CH6_PARTS["tap"])
+    return chapter6_runs(base_config) + tap

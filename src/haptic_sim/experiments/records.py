@@ -126,6 +126,28 @@ class GraphOnset:
 
 
 @dataclass(frozen=True)
+class TapPoint:
+    """One wall of chapter 6's tap protocol: the motion 2-3 s after the tap (RMS about its slow
+    trend, m; its dominant frequency, Hz) and whether that is a sustained vibration."""
+
+    wall: float
+    residual_rms_m: float
+    frequency_hz: float
+    vibrates: bool
+
+
+@dataclass(frozen=True)
+class TapSweep:
+    """One controller's walls under the tap, through the graph, and the first that vibrates."""
+
+    controller: str  # label
+    mode: str
+    kf: float
+    points: list[TapPoint]  # by wall
+    first_vibrating_n_per_m: float | None  # None: none of its walls
+
+
+@dataclass(frozen=True)
 class Ch7Result:
     """Chapter 7 through the graph: one analysis per (controller, wall) and the checks."""
 
@@ -135,10 +157,12 @@ class Ch7Result:
 
 @dataclass(frozen=True)
 class Ch6Result:
-    """Chapter 6 through the graph: one analysis per (controller, wall), onsets and checks."""
+    """Chapter 6 through the graph: one analysis per (controller, wall) of both protocols, the
+    linear protocol's onsets, the tap's sweeps, and the checks."""
 
     rows: list[RunAnalysis]
-    onsets: list[GraphOnset]  # per controller
+    onsets: list[GraphOnset]  # per controller, the linear protocol
+    taps: list[TapSweep]  # per controller, the tap with the configuration's friction
     checks: list[Check]
 
 

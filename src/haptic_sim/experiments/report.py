@@ -2,9 +2,9 @@
 
 ``write(root, results, base)`` renders ``root/report.md`` from the typed results
 ``haptic-experiment`` gathered (``results.json``): one section per part that was run, in the order
-of ``parts.EXPERIMENTS``, then the acceptance checks, the configuration, where the simulation
-differs from the thesis, and the timing. The numbers come from the bags' analyses and the batch
-studies, never typed in, except the thesis's own tables (``thesis``).
+of ``parts.EXPERIMENTS`` after the one configuration they all run, then the acceptance checks,
+where the simulation differs from the thesis, and the timing. The numbers come from the bags'
+analyses and the batch studies, never typed in, except the thesis's own tables (``thesis``).
 """
 
 from __future__ import annotations
@@ -54,6 +54,7 @@ def write(root: Path, res: ExperimentResults, base: SessionConfig) -> Path:
         "regenerate any of them with `haptic-analyze runs/<run>/bag --json`), chapter 4's "
         "model identified as `haptic-identify runs/ch4_step_2p4/bag` does.\n"
     )
+    md += ["## One plant and one observer configuration", "", config_table(res, base)]
     checks = [c for e, r in present(res) for c in e.checks(r)]
     for e, r in present(res):
         md += section(e, r, base, figs)
@@ -61,7 +62,6 @@ def write(root: Path, res: ExperimentResults, base: SessionConfig) -> Path:
         md += ["## Acceptance checks", ""]
         md += [f"- [{'x' if c.passed else ' '}] {c.text}" for c in checks]
         md.append("")
-    md += ["## Configuration", "", config_table(res, base)]
     md += ["## Where the simulation differs from the thesis", "", differences(res)]
     timing = ", ".join(f"{k} {v:.0f} s" for k, v in res.timing_s.items())
     md += ["## Timing", "", timing + "\n"]

@@ -3,9 +3,10 @@
 ``analyse_run`` writes ``analysis.json`` beside the run's bag with exactly what
 ``haptic-analyze BAG --json`` prints for it (default settings), so every number of the report can
 be regenerated from the bags by the analysis alone. The chapter-7 tables take the transparency of
-each run; the chapter-6 onsets take each run's pulse response (``perturbation_growth_per_s``) and
-interpolate its zero crossing along the walls (``haptic_sim.stability.onset``), as the batch sweep
-does.
+each run; the chapter-6 onsets take each linear-protocol run's pulse response
+(``perturbation_growth_per_s``) and interpolate its zero crossing along the walls
+(``haptic_sim.stability.onset``), as the batch sweep does; its tap runs are read for their
+residual motion (``ch6tap``).
 """
 
 from __future__ import annotations
@@ -17,8 +18,9 @@ from typing import Any
 
 from haptic_dob.analysis.linear_loop import linear_onset
 from haptic_sim.experiments import thesis
+from haptic_sim.experiments.ch6tap import tap_checks, tap_result
 from haptic_sim.experiments.graph_runs import GraphRun, bag_path, run_dir
-from haptic_sim.experiments.plan import CH7_CONTROLLERS, CH7_WALLS
+from haptic_sim.experiments.plan import CH6_PARTS, CH7_CONTROLLERS, CH7_WALLS
 from haptic_sim.experiments.records import (
     Ch6Result,
     Ch7Result,
@@ -187,6 +189,9 @@ def ch6_checks(onsets: list[GraphOnset], base: SessionConfig) -> list[Check]:
 
 
 def ch6_result(rows: list[RunAnalysis], base: SessionConfig) -> Ch6Result:
-    """Chapter 6's rows, onsets and checks (the bound from the base config's slide and rate)."""
-    onsets = ch6_onsets(rows)
-    return Ch6Result(rows, onsets, ch6_checks(onsets, base))
+    """Chapter 6's rows, the linear protocol's onsets, the tap's sweeps (each tap run's bag read
+    for its residual motion) and the checks (the bound from the base config's slide and rate)."""
+    linear = [r for r in rows if r.part != CH6_PARTS["tap"]]
+    onsets = ch6_onsets(linear)
+    taps = tap_result([r for r in rows if r.part == CH6_PARTS["tap"]], base.loop.rate_hz)
+    return Ch6Result(rows, onsets, taps, ch6_checks(onsets, base) + tap_checks(taps))

@@ -5,13 +5,28 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+from haptic_dob.analysis.linear_loop import chatter_gain
 from haptic_sim.experiments import thesis
-from haptic_sim.experiments.dob import VIBRATION_RMS_M, WALLS, DobStudy, KickPoint
+from haptic_sim.experiments.dob import (
+    GRIPS,
+    WALLS,
+    DobStudy,
+    GripPoint,
+    KickPoint,
+    first_vibrating_with,
+)
 from haptic_sim.experiments.plan import CH7_CONTROLLERS
-from haptic_sim.experiments.records import ExperimentResults, GraphOnset, RunAnalysis, label
+from haptic_sim.experiments.records import (
+    ExperimentResults,
+    GraphOnset,
+    RunAnalysis,
+    TapSweep,
+    label,
+)
 from haptic_sim.experiments.results import bound, ch7_grid
 from haptic_sim.experiments.zwidth import MapPoint
 from haptic_sim.session import SessionConfig
+from haptic_sim.stability import VIBRATION_RMS_M
 
 
 def fmt(v: float | None, spec: str = ".2f", none: str = "–") -> str:
@@ -84,6 +99,29 @@ def ch6_table(onsets: list[GraphOnset], b: float, rate_hz: float) -> str:
     return "\n".join(lines) + "\n"
 
 
+def ch6_tap_table(taps: list[TapSweep]) -> str:
+    """The tap protocol: each wall's residual motion and the first wall that keeps vibrating."""
+    lines = [
+        "**With the plant's friction, tapped** (3 N for 20 ms; motion 2-3 s after the tap, um RMS "
+        f"about its trend, at its dominant frequency; vibrating above {VIBRATION_RMS_M * 1e6:g} "
+        "um):",
+        "",
+        "| controller | residual motion per wall (N/m: um) | first wall that keeps vibrating "
+        "(N/m) | thesis (N/m) |",
+        "|---|---|---|---|",
+    ]
+    for t in taps:
+        cells = ", ".join(
+            f"{p.wall:g}: {p.residual_rms_m * 1e6:.1f}"
+            + (f" @ {p.frequency_hz:.0f} Hz" if p.vibrates else "")
+            for p in t.points
+        )
+        ref = thesis.ONSET_N_PER_M.get(t.mode)
+        first = fmt(t.first_vibrating_n_per_m, "g", "none")
+        lines.append(f"| {t.controller} | {cells} | {first} | {fmt(ref, 'g')} |")
+    return "\n".join(lines) + "\n"
+
+
 def ch7_console(rows: list[RunAnalysis]) -> list[str]:
     """The chapter-7 cells for the terminal, by wall, beside the thesis's."""
 
@@ -101,9 +139,14 @@ def ch7_console(rows: list[RunAnalysis]) -> list[str]:
     return out
 
 
-def ch6_console(onsets: list[GraphOnset]) -> list[str]:
-    """The chapter-6 onsets for the terminal."""
-    return [f"onset {e.controller}: {fmt(e.onset_n_per_m, '.0f')} N/m" for e in onsets]
+def ch6_console(onsets: list[GraphOnset], taps: list[TapSweep]) -> list[str]:
+    """The chapter-6 onsets and the tap's first vibrating walls for the terminal."""
+    out = [f"onset {e.controller}: {fmt(e.onset_n_per_m, '.0f')} N/m" for e in onsets]
+    return out + [
+        f"tapped with friction, {t.controller}: first vibrating wall "
+        f"{fmt(t.first_vibrating_n_per_m, 'g', 'none')} N/m"
+        for t in taps
+    ]
 
 
 # --- the stability map --------------------------------------------------------------------------
@@ -132,6 +175,11 @@ def _kick_cell(p: KickPoint) -> str:
     return f"{rms} @ {p.frequency_hz:.0f} Hz" if p.vibrates else rms
 
 
+def _grip_cell(p: GripPoint) -> str:
+    rms = f"{p.residual_rms_m * 1e6:.1f}"
+    return f"{rms} @ {p.frequency_hz:.0f} Hz" if p.vibrates else rms
+
+
 def dob_tables(d: DobStudy) -> str:
     """Tables of the mechanism study."""
     lines = [
@@ -148,8 +196,19 @@ def dob_tables(d: DobStudy) -> str:
         )
     lines += [
         "",
-        f"**Kick grid** (DOB Kf = 100; residual motion 2-3 s after the kick, um RMS; "
-        f"vibrating above {VIBRATION_RMS_M * 1e6:g} um):",
+        "**The gain above which DOB chatters at the sample rate** (the linear model's mode near "
+        "-Kf c T / (2 m): the command alternating its sign every period), N s/m:",
+        "",
+        "| Kf | with the amplifier lag | without (about 2 m / (Kf T)) |",
+        "|---|---|---|",
+    ]
+    for g in d.chatter:
+        lag, no_lag = fmt(g.gain, ".1f", "none"), fmt(g.gain_without_lag, ".1f", "none")
+        lines.append(f"| {g.kf:g} | {lag} | {no_lag} |")
+    lines += [
+        "",
+        f"**Tap grid** (DOB Kf = 100, chapter 6's tap in batch; residual motion 2-3 s after the "
+        f"tap, um RMS; vibrating above {VIBRATION_RMS_M * 1e6:g} um):",
         "",
         "| c (N s/m) | Coulomb (N) | "
         + " | ".join(f"{w:g}" for w in WALLS)
@@ -168,18 +227,26 @@ def dob_tables(d: DobStudy) -> str:
             + " | ".join(cols)
             + f" | {fmt(fv.wall, 'g', 'none')} |"
         )
-    lines += [
-        "",
-        "**DOB Kf = 1 transparency against the observer gain** (batch, 800 N/m, the "
-        "chapter-7 hand):",
-        "",
-        "| c (N s/m) | bandwidth (Hz) | impedance error (%) |",
-        "|---|---|---|",
-    ]
-    for g in d.bandwidth_vs_gain:
-        lines.append(
-            f"| {g.gain:g} | {fmt(g.bandwidth_hz)} | {fmt(g.impedance_error_pct, '.1f')} |"
-        )
+    if d.grips:
+        lines += [
+            "",
+            "**The tap with another hand** (DOB Kf = 100, the configuration's gain and friction; "
+            "residual motion 2-3 s after the tap, um RMS):",
+            "",
+            "| hand | " + " | ".join(f"{w:g}" for w in WALLS) + " | first wall that vibrates |",
+            "|---|" + "---|" * (len(WALLS) + 1),
+        ]
+        for grip in GRIPS:
+            by_wall = {p.stiffness_n_per_m: p for p in d.grips if p.grip == grip.name}
+            if not by_wall:
+                continue
+            taps = [_grip_cell(by_wall[w]) for w in WALLS if w in by_wall]
+            first = fmt(first_vibrating_with(d.grips, grip.name), "g", "none")
+            hand = (
+                f"{grip.name}: {grip.mass_kg:g} kg, {grip.stiffness_n_per_m:g} N/m, "
+                f"{grip.damping_n_s_per_m:g} N s/m"
+            )
+            lines.append(f"| {hand} | " + " | ".join(taps) + f" | {first} |")
     if d.model_mismatch:
         lines += [
             "",
@@ -201,18 +268,35 @@ def dob_tables(d: DobStudy) -> str:
 
 # --- configuration ------------------------------------------------------------------------------
 def config_table(res: ExperimentResults, base: SessionConfig) -> str:
-    """The parameters that shape the results."""
+    """The one plant and the one observer configuration every part runs, and what each part sets
+    on top (the hand, the wall, the protocol)."""
     m, s, h, d, o = base.model, base.sensor, base.hand, base.device, base.observer
+    chatter = chatter_gain(
+        100.0,
+        m.mass_kg,
+        m.viscous_n_s_per_m,
+        1.0 / base.loop.rate_hz,
+        amplifier_lag_s=d.amplifier_lag_s,
+    )
     rows = [
         (
-            "simulated slide (its truth)",
+            "simulated slide (its truth, `plant.*`)",
             f"m {d.mass_kg} kg, viscous {d.viscous_n_s_per_m} N s/m, Coulomb {d.coulomb_n} N, "
             f"static {d.stiction_ratio:g} x Coulomb over {1e3 * d.stribeck_velocity_m_per_s:g} "
             f"mm/s (Stribeck), amplifier lag {1e3 * d.amplifier_lag_s:g} ms",
         ),
         (
-            "assumed model (observer, controller)",
-            f"m {m.mass_kg} kg, viscous b {m.viscous_n_s_per_m} N s/m, Coulomb {m.coulomb_n} N",
+            "the observer's and controller's model (`slide.*`)",
+            f"m {m.mass_kg} kg, viscous {m.viscous_n_s_per_m} N s/m, Coulomb {m.coulomb_n} N: "
+            "least squares on chapter 4's 2.4 N bag (`haptic-identify "
+            "runs/ch4_step_2p4/bag`) to 4 digits (chapter 4 checks it)",
+        ),
+        (
+            "observer, every chapter",
+            f"c = {o.gain:g} N s/m (m/c = {1e3 * m.mass_kg / o.gain:.0f} ms, corner "
+            f"{o.gain / (2 * math.pi * m.mass_kg):.1f} Hz): the fastest whole gain below "
+            f"{fmt(chatter, '.1f')} N s/m, above which DOB at the thesis's Kf = 100 chatters at "
+            f"the sample rate (the DOB section); output limit {o.output_limit} N",
         ),
         ("loop", f"{base.loop.rate_hz:g} Hz, {base.loop.substeps} physics sub-steps, lockstep"),
         ("actuator", f"saturation {d.max_force_n} N, encoder {d.encoder_resolution_m} m"),
@@ -220,22 +304,25 @@ def config_table(res: ExperimentResults, base: SessionConfig) -> str:
             "force sensor",
             f"bandwidth {s.bandwidth_hz} Hz, noise {s.noise_std_n} N RMS, bias {s.bias_n} N",
         ),
-        (
-            "observer",
-            f"c = {o.gain} N s/m (m/c = {1e3 * m.mass_kg / o.gain:.0f} ms), output "
-            f"limit {o.output_limit} N, model = the assumed model above",
-        ),
         ("controller", f"saturation {base.law.max_force_n} N"),
         (
-            "hand, ch. 7",
+            "hand, ch. 5 and 7",
             f"{h.behaviour}: mass {h.mass_kg} kg, grip {h.stiffness_n_per_m} N/m, "
             f"damping {h.damping_n_s_per_m} N s/m, band {h.band_low_hz}-{h.band_high_hz} Hz, push "
             f"and swing scaled to the wall; seed {res.seed}",
         ),
         (
             "hand, ch. 6",
-            "push-and-hold: 1 N through a 20 N/m grip, no hand mass or damping, "
-            "Coulomb friction off, 0.5 N x 5 ms pulse at 1.5 s",
+            "push-and-hold: 1 N through a 20 N/m grip, no hand mass or damping; a 0.5 N x 5 ms "
+            "pulse (linear protocol) or a 3 N x 20 ms tap at 1.5 s",
+        ),
+        (
+            "set per part",
+            "ch. 4: OL, no hand, an 80 N/m two-sided spring and a known force; ch. 6's linear "
+            "protocol only: Coulomb friction 0 in the plant and the model, the premise of the "
+            "passivity bounds (with it OL and CL keep no vibration: the tap table). Nothing "
+            "else changes the plant or the observer; the batch sweeps change one parameter "
+            "each, named in their tables",
         ),
     ]
     head = (
