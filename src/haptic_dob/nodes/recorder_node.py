@@ -1,29 +1,19 @@
 """recorder_node: record a session into a rosbag2 (MCAP or sqlite3) with the ``rosbags`` writer.
 
-- Subscribes raw (serialized CDR) to each topic and writes the bytes as they are: reliable
-  ``qos.RECORD`` for the loop's topics (a recorder that falls behind is repaired from the
-  publishers' last 2000 samples), the parameter-events profile for ``/parameter_events``,
-  reliable volatile for other topics. Bag time: the session's (``log_time``, as ``ros2 bag
-  record --use-sim-time``; ``/clock`` is read where no loop topic is recorded) or receive time.
-- Writes a snapshot of every node in its ``namespaces`` (default its own; ``list_parameters`` +
-  ``get_parameters``; a node silent for ``snapshot_timeout_s`` is warned about and still asked) as a
-  ``rcl_interfaces/msg/ParameterEvent`` with all parameters in ``new_parameters``, on
-  ``/parameter_events`` beside the live events, so the bag says which stiffness, mode and gains
-  were active at every moment. Nodes that start later are snapshot when they appear.
-- Publishes ``recorder/progress`` in each of them (``std_msgs/Header``: the stamp, and its name in
-  ``frame_id`` so a device can follow the slowest of several; reliable, transient local) at
-  ``progress_rate_hz``: the newest stamp written, minimum over the stamped topics that are
-  flowing (header stamps; the effort command's ``effort@<stamp>`` label). A lockstep device
-  holds the loop while that lags, so a recorded lockstep run loses nothing. The report is held
-  where a node appeared until its parameters came (at most ``snapshot_timeout_s``), so a short
-  lockstep run cannot end before the bag knows the session's parameters. Before the first loop
-  sample it reports ``PROGRESS_NOT_MATCHED_NS`` while a reader has not matched its writers
-  (``haptic_dob.recorder.matching``): the device sends sample 0 only after that.
-- On SIGINT/SIGTERM (or after ``duration_s``) it takes what is still queued (at most
-  ``drain_timeout_s``, until nothing arrives for 0.1 s), then closes the bag so it is readable,
-  and reports per topic what it received, wrote and which stamps are missing (gaps).
+- Subscribes raw (serialized CDR) and writes the bytes as they are: reliable ``qos.RECORD`` for
+  the loop's topics, the parameter-events profile for ``/parameter_events``, reliable volatile
+  otherwise. Bag time: the session's (``log_time``; ``/clock`` where no loop topic is recorded)
+  or receive time.
+- Snapshots the parameters of every node in its ``namespaces`` (as a ``ParameterEvent`` on
+  ``/parameter_events``), nodes that start later when they appear.
+- Publishes ``recorder/progress`` (``std_msgs/Header``: newest stamp written over the flowing
+  topics, its name in ``frame_id``) at ``progress_rate_hz``: a lockstep device holds the loop
+  while that lags, and sends sample 0 only once every reader matched, so nothing is lost.
+- On SIGINT/SIGTERM (or after ``duration_s``) takes what is still queued (at most
+  ``drain_timeout_s``), closes the bag readable and logs per topic what it received and wrote.
 
-The ROS-free parts (topics, the bag, counts, snapshots) are in ``haptic_dob.recorder``.
+The ROS-free parts (topics, the bag, counts, snapshots) are in ``haptic_dob.recorder``;
+docs/recording-and-analysis.md has the details.
 """
 
 from __future__ import annotations
@@ -217,10 +207,8 @@ class RecorderNode(LoopNode):
         return got
 
     def _finish_snapshots(self) -> None:
-        """Wait (within ``drain_timeout_s``) for the snapshots still asked for: in a short run a
-        loaded node may answer after the session ended; a snapshot declares values from the
-        start, so a late one still labels the whole bag. Only when this node spins alone (in a
-        composition the other nodes have shut down already)."""
+        """Wait (within ``drain_timeout_s``) for snapshots still asked for (a late one still
+        labels the whole bag); only when this node spins alone, not in a composition."""
         ex = self.executor
         if ex is None or len(ex.get_nodes()) != 1:
             return
