@@ -102,9 +102,12 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         "device_node:duration_s=0.0",
         f"controller_node:mode={mode}",
         "controller_node:kf=1.0",
-        # a fine encoder: consecutive commands differ, so the run of equal efforts before the
-        # zero starts at the first sample that shows the last command the device received
+        # a fine encoder and no Coulomb friction (the slide never sticks, so its position never
+        # repeats; stuck by stiction it held equal efforts for up to 40 samples): consecutive
+        # commands differ, so the run of equal efforts before the zero starts at the first sample
+        # that shows the last command the device received
         "device_node:plant.encoder_resolution_m=1.0e-9",
+        "device_node:plant.coulomb_n=0.0",
     ]
     col = Collector(
         env,
