@@ -250,7 +250,7 @@ SWEEPS: Experiment[sweeps.SweepStudy] = Experiment(
     result_type=sweeps.SweepStudy,
     job=BatchJob(
         lambda base, pool, _figs: sweeps.study(base, pool),
-        lambda r: f"Table 7.1's off cells swept: {len(r.cells) + len(r.seeds)} sessions",
+        lambda r: f"Table 7.1's off cells swept: {len(r.cells) + len(r.seeds)} cells",
     ),
     heading="Table 7.1's cells that stay off, against the parameter responsible (batch)",
     intro="Controllers of Table 7.1 in the chapter-7 session (40 s, the hand's seed 0, "

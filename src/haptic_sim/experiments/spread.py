@@ -56,21 +56,39 @@ def chapter7_session(
     )
 
 
-def _cell(args: tuple[SessionConfig, str, float, float, int]) -> SeedCell:
-    base, mode, kf, wall, seed = args
-    s = run_session(chapter7_session(base, mode, kf, wall, seed)).summary()
-    return SeedCell(seed, mode, kf, wall, s["bandwidth_hz"])
+@dataclass(frozen=True)
+class PlannedCell:
+    """A Table 7.1 cell for one seed, before it runs: which, and its batch session."""
+
+    seed: int
+    mode: str
+    kf: float
+    wall: float
+    config: SessionConfig
+
+    def with_bandwidth(self, bandwidth_hz: float | None) -> SeedCell:
+        """The cell with its session's bandwidth (Hz; None if none)."""
+        return SeedCell(self.seed, self.mode, self.kf, self.wall, bandwidth_hz)
 
 
-def seed_cells(base: SessionConfig, executor: Executor | None = None) -> list[SeedCell]:
-    """Every Table 7.1 cell for every seed of ``SEEDS``."""
-    jobs = [
-        (base, mode, kf, wall, seed)
+def cells(base: SessionConfig) -> list[PlannedCell]:
+    """Every Table 7.1 cell for every seed of ``SEEDS``, not yet run."""
+    return [
+        PlannedCell(seed, mode, kf, wall, chapter7_session(base, mode, kf, wall, seed))
         for seed in SEEDS
         for (mode, kf) in thesis.BANDWIDTH_HZ
         for wall in thesis.WALLS
     ]
-    return list(executor.map(_cell, jobs)) if executor else [_cell(j) for j in jobs]
+
+
+def _run(cell: PlannedCell) -> SeedCell:
+    return cell.with_bandwidth(run_session(cell.config).summary()["bandwidth_hz"])
+
+
+def seed_cells(base: SessionConfig, executor: Executor | None = None) -> list[SeedCell]:
+    """Every Table 7.1 cell for every seed of ``SEEDS``, run."""
+    planned = cells(base)
+    return list(executor.map(_run, planned)) if executor else [_run(c) for c in planned]
 
 
 def spread_table(cells: list[SeedCell]) -> str:

@@ -191,28 +191,41 @@ class SweepStudy:
         ]
 
 
-def _session(args: tuple[SessionConfig, Sweep, str, float, float, float]) -> SweepCell:
-    base, sweep, mode, kf, wall, value = args
-    cfg = sweep.config(base, mode, kf, wall, value)
+@dataclass(frozen=True)
+class _Measured:
+    """What one batch session gives: a sweep cell's figures and Table 7.1's bandwidth (Hz)."""
+
+    bandwidth_hz: float | None
+    impedance_error_pct: float | None
+    coherence_in_band: float | None
+    first_bin_db: float | None
+    mean_db_to_5hz: float | None
+    saturated_pct: float
+    onset_n_per_m: float | None  # chapter 6's linear onset over the job's walls, if any
+    table_bandwidth_hz: float | None  # the session summary's, as Table 7.1 and ``spread`` read it
+
+
+Job = tuple[SessionConfig, tuple[float, ...]]  # a session, and the walls of its onset (or ())
+
+
+def _measure(job: Job) -> _Measured:
+    cfg, onset_walls = job
     res = run_session(cfg)
     k0 = round(SETTLE_S * cfg.loop.rate_hz)
     limit = cfg.device.max_force_n * (1.0 - 1e-9)
     saturated = float(np.mean(np.abs(res.effort[k0:]) >= limit) * 100.0)
     onset = None
-    if sweep.onset_walls and wall == sweep.walls[0]:
-        onset = stability_sweep(list(sweep.onset_walls), cfg).onset_stiffness_n_per_m
+    if onset_walls:
+        onset = stability_sweep(list(onset_walls), cfg).onset_stiffness_n_per_m
+    table_bw = res.summary(SETTLE_S)["bandwidth_hz"]
     try:
-        tr = transparency(res.q[k0:], res.force_measured[k0:], cfg.loop.rate_hz, wall)
+        tr = transparency(
+            res.q[k0:], res.force_measured[k0:], cfg.loop.rate_hz, cfg.wall.stiffness_n_per_m
+        )
     except ValueError:  # no motion to measure
-        nothing = (None, None, None, None, None)
-        return SweepCell(sweep.name, mode, kf, wall, value, *nothing, saturated, onset)
+        return _Measured(None, None, None, None, None, saturated, onset, table_bw)
     db = tr.magnitude_db
-    return SweepCell(
-        sweep.name,
-        mode,
-        kf,
-        wall,
-        value,
+    return _Measured(
         tr.bandwidth_hz,
         tr.impedance_error_pct,
         tr.mean_coherence_in_band,
@@ -220,21 +233,68 @@ def _session(args: tuple[SessionConfig, Sweep, str, float, float, float]) -> Swe
         float(np.mean(db[tr.freqs_hz <= 5.0])),
         saturated,
         onset,
+        table_bw,
     )
+
+
+def _onset_walls(sweep: Sweep, wall: float) -> tuple[float, ...]:
+    """The walls of chapter 6's onset for this cell: once per value, at the sweep's first wall."""
+    return sweep.onset_walls if sweep.onset_walls and wall == sweep.walls[0] else ()
+
+
+def _cell(sweep: Sweep, mode: str, kf: float, wall: float, value: float, m: _Measured) -> SweepCell:
+    onset = m.onset_n_per_m if _onset_walls(sweep, wall) else None
+    return SweepCell(
+        sweep.name,
+        mode,
+        kf,
+        wall,
+        value,
+        m.bandwidth_hz,
+        m.impedance_error_pct,
+        m.coherence_in_band,
+        m.first_bin_db,
+        m.mean_db_to_5hz,
+        m.saturated_pct,
+        onset,
+    )
+
+
+def _session(args: tuple[SessionConfig, Sweep, str, float, float, float]) -> SweepCell:
+    """One sweep cell, run on its own."""
+    base, sweep, mode, kf, wall, value = args
+    cfg = sweep.config(base, mode, kf, wall, value)
+    return _cell(sweep, mode, kf, wall, value, _measure((cfg, _onset_walls(sweep, wall))))
 
 
 def study(base: SessionConfig, executor: Executor | None = None) -> SweepStudy:
     """Every sweep for its controllers (``DURATION_S`` sessions, seed ``SEED``) and Table 7.1 for
-    the hand's other seeds (``spread``)."""
-    jobs = [
-        (base, s, mode, kf, wall, v)
+    the hand's other seeds (``spread``). A session that two cells share (each sweep's first
+    value is a chapter-7 cell, and so is seed 0's table) runs once."""
+    specs = [
+        (s, mode, kf, wall, v)
         for s in SWEEPS
         for (mode, kf) in s.controllers
         for wall in s.walls
         for v in s.values_for(base)
     ]
-    cells = list(executor.map(_session, jobs)) if executor else [_session(j) for j in jobs]
-    return SweepStudy(cells, spread.seed_cells(base, executor))
+    seeds = spread.cells(base)
+    runs: dict[SessionConfig, tuple[float, ...]] = {}  # each distinct session: its onset walls
+    for s, mode, kf, wall, v in specs:
+        cfg = s.config(base, mode, kf, wall, v)
+        runs[cfg] = runs.get(cfg, ()) or _onset_walls(s, wall)
+    for seed_cell in seeds:
+        runs.setdefault(seed_cell.config, ())
+    jobs = list(runs.items())
+    measured = list(executor.map(_measure, jobs)) if executor else [_measure(j) for j in jobs]
+    by_config = {cfg: m for (cfg, _), m in zip(jobs, measured, strict=True)}
+    cells = [
+        _cell(s, mode, kf, wall, v, by_config[s.config(base, mode, kf, wall, v)])
+        for s, mode, kf, wall, v in specs
+    ]
+    return SweepStudy(
+        cells, [c.with_bandwidth(by_config[c.config].table_bandwidth_hz) for c in seeds]
+    )
 
 
 def label(mode: str, kf: float) -> str:

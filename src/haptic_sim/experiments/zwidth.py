@@ -9,7 +9,6 @@ beside the passivity bound ``K T / 2 + |B| < b / (1 + Kf)`` (figures in ``figure
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from concurrent.futures import Executor
 from dataclasses import dataclass
 
@@ -18,7 +17,7 @@ import numpy as np
 from haptic_dob.environment import VirtualWall
 from haptic_dob.observer import ObserverSettings
 from haptic_sim.session import SessionConfig
-from haptic_sim.stability import StabilityProtocol, law_for, onset, sweep
+from haptic_sim.stability import StabilityPoint, StabilityProtocol, growth_at, law_for, onset
 
 K_MIN, K_MAX = 5.0, 20000.0
 #: the onset against Kf (B = 0): CL and DOB at these Kf, and OL
@@ -26,6 +25,8 @@ MAP_KFS = [0.5, 1.0, 2.0, 5.0, 10.0, 25.0, 100.0]
 #: the Z-width: these controllers against these wall dampings (N s/m)
 ZWIDTH_CONTROLLERS = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0)]
 ZWIDTH_DAMPINGS = [0.0, 0.25, 0.5, 1.0]
+#: points a pool worker takes at a time (one point is a 4 s session: a fraction of a second)
+CHUNK = 4
 
 
 @dataclass(frozen=True)
@@ -53,26 +54,48 @@ def passivity_bound(b: float, T: float, kf: float, damping: float) -> float:
     return max(0.0, 2.0 * (b / (1.0 + kf) - abs(damping)) / T)
 
 
-def find_onset(
-    base: SessionConfig,
+def _growth(
+    jobs: list[tuple[SessionConfig, float]],
+    protocol: StabilityProtocol,
+    executor: Executor | None,
+) -> list[StabilityPoint]:
+    """The protocol at every (configuration, stiffness) of ``jobs``, in order, in one batch."""
+    args = ([protocol] * len(jobs), [c for c, _ in jobs], [k for _, k in jobs])
+    if executor is None:
+        return list(map(growth_at, *args))
+    return list(executor.map(growth_at, *args, chunksize=CHUNK))
+
+
+def find_onsets(
+    cfgs: list[SessionConfig],
     protocol: StabilityProtocol,
     executor: Executor | None,
     coarse: int = 16,
     fine: int = 8,
-) -> tuple[float | None, bool]:
-    """Coarse geometric sweep, then a fine linear one around the first vibrating stiffness."""
-    grid = np.geomspace(K_MIN, K_MAX, coarse)
-    first = sweep(grid, base, protocol, executor=executor)
-    vib = [p.vibrates for p in first.points]
-    if not any(vib):
-        return None, False
-    i = vib.index(True)
-    if i == 0:
-        return float(grid[0]), True
-    lo, hi = grid[i - 1], grid[i]
-    second = sweep(np.linspace(lo, hi, fine), base, protocol, executor=executor)
-    k_on = onset(second.points)
-    return (None if k_on is None else float(k_on)), False
+) -> list[tuple[float | None, bool]]:
+    """Per configuration (onset N/m or None, vibrated already at ``K_MIN``): a coarse geometric
+    sweep, then a fine linear one around the first vibrating stiffness. Every configuration's
+    coarse points go to the pool as one batch, then every fine point: no worker waits for the
+    slowest point of one sweep before the next sweep starts."""
+    grid = [float(k) for k in np.geomspace(K_MIN, K_MAX, coarse)]
+    first = _growth([(c, k) for c in cfgs for k in grid], protocol, executor)
+    out: list[tuple[float | None, bool] | None] = []
+    refine: list[tuple[int, list[float]]] = []  # (configuration, its fine grid)
+    for i in range(len(cfgs)):
+        vib = [p.vibrates for p in first[i * coarse : (i + 1) * coarse]]
+        if not any(vib):
+            out.append((None, False))
+        elif vib[0]:
+            out.append((grid[0], True))
+        else:
+            j = vib.index(True)
+            out.append(None)
+            refine.append((i, [float(k) for k in np.linspace(grid[j - 1], grid[j], fine)]))
+    second = _growth([(cfgs[i], k) for i, ks in refine for k in ks], protocol, executor)
+    for n, (i, _ks) in enumerate(refine):
+        k_on = onset(second[n * fine : (n + 1) * fine])
+        out[i] = (None if k_on is None else float(k_on)), False
+    return [o for o in out if o is not None]
 
 
 def stability_map(
@@ -81,26 +104,29 @@ def stability_map(
     base: SessionConfig | None = None,
     observer_gain: float | None = None,
     executor: Executor | None = None,
-    progress: Callable[[MapPoint], None] | None = None,
 ) -> list[MapPoint]:
     """Onsets for every (controller, Kf) and wall damping (``executor``: a shared process pool)."""
     base = base or SessionConfig()
     if observer_gain is not None:
         base = base.replace(observer=ObserverSettings(observer_gain, base.observer.output_limit))
-    protocol = StabilityProtocol()
-    out = []
     T = 1.0 / base.loop.rate_hz
     b = base.device.viscous_n_s_per_m
-    for mode, kf in controllers:
-        for damping in dampings:
-            w = base.wall
-            cfg = base.replace(
-                law=law_for(mode, kf, base.law.max_force_n),
-                wall=VirtualWall(w.stiffness_n_per_m, damping, w.position, w.normal),
-            )
-            k_on, below = find_onset(cfg, protocol, executor)
-            kf_eff = kf if mode != "OL" else 0.0
-            point = MapPoint(
+    w = base.wall
+    cases = [(mode, kf, damping) for mode, kf in controllers for damping in dampings]
+    cfgs = [
+        base.replace(
+            law=law_for(mode, kf, base.law.max_force_n),
+            wall=VirtualWall(w.stiffness_n_per_m, damping, w.position, w.normal),
+        )
+        for mode, kf, damping in cases
+    ]
+    out = []
+    for (mode, kf, damping), (k_on, below) in zip(
+        cases, find_onsets(cfgs, StabilityProtocol(), executor), strict=True
+    ):
+        kf_eff = kf if mode != "OL" else 0.0
+        out.append(
+            MapPoint(
                 mode,
                 kf_eff,
                 damping,
@@ -109,9 +135,7 @@ def stability_map(
                 below,
                 passivity_bound(b, T, kf_eff, damping),
             )
-            out.append(point)
-            if progress:
-                progress(point)
+        )
     return out
 
 
