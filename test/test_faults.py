@@ -175,7 +175,12 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
             return bool(np.sum(np.abs(e[t > t_restart]) > 0.1) > 200)
 
         if not wait_until(resumed, 40, poll_s=0.2):
-            pytest.fail(f"the loop did not resume after restarting {victim}")
+            _, _, e = efforts(col)
+            pytest.fail(
+                f"the loop did not resume after restarting {victim} ({e.size} samples, the last "
+                f"efforts {e[-5:]}); {victim}: {procs[victim].output()[-1500:]}; the rest: "
+                f"{procs['device_node'].output()[-1500:]}"
+            )
         # ... and keeps coming (a snapshot of the last samples could fall in a watchdog trip
         # when this loaded machine stalls a process for more than the 5 ms command timeout)
         assert wait_for_effort(col, t_restart, 400, 20), f"the loop did not stay closed: {victim}"

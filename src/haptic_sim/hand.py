@@ -29,7 +29,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import signal
 
 from haptic_dob.runtime.params import param
 from haptic_dob.validation import finite_scalar, nonnegative, positive
@@ -136,6 +135,8 @@ def reference_for_force(
 
 def _band_filter(params: HandParams, dt: float) -> np.ndarray:
     """The reference's band-pass (4th-order Butterworth) at sample period ``dt`` (s)."""
+    from scipy import signal  # here: a device process without a band (push and hold) starts faster
+
     nyq = 0.5 / dt
     sos: np.ndarray = signal.butter(
         4, [params.band_low_hz / nyq, params.band_high_hz / nyq], btype="bandpass", output="sos"
@@ -207,6 +208,8 @@ class HandReference:
             ramp = np.ones(n)
         pos = ramp * p.offset_m if p.active else np.zeros(n)
         if self._sos is not None:
+            from scipy import signal
+
             noise, self._zi = signal.sosfilt(self._sos, self._rng.standard_normal(n), zi=self._zi)
             pos = pos + self._scale * ramp * noise
         prev = np.concatenate(([self._last_x], pos[:-1]))
@@ -224,6 +227,8 @@ def _noise_gain(sos: np.ndarray, dt: float, low_hz: float) -> float:
     ``sigma^2 = 2 dt * integral_0^{fs/2} |H(f)|^2 df``, integrated on a log-spaced grid dense
     around the pass band.
     """
+    from scipy import signal
+
     fs = 1.0 / dt
     f = np.geomspace(low_hz * 1e-3, fs / 2.0, 200_000)
     _, h = signal.sosfreqz(sos, worN=f, fs=fs)

@@ -31,7 +31,6 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy import signal
 
 from haptic_dob.analysis.vibration import envelope_growth
 
@@ -108,6 +107,8 @@ def _window(
     segment_s: float,
 ) -> Oscillation | None:
     """The figures of one window (see the module docstring)."""
+    from scipy import signal  # on use: a node process that never analyses starts faster
+
     lo, hi = s.band_hz
     hi = min(hi, 0.45 * fs_hz)
     nper = round(segment_s * fs_hz)

@@ -21,7 +21,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import signal
 
 from haptic_dob.validation import nonnegative, positive
 
@@ -66,6 +65,8 @@ def h1_impedance(
     Raises ``ValueError`` when the arrays differ in length, are not finite, hold less than one
     segment, or the motion is constant.
     """
+    from scipy import signal  # on use: a node process that never analyses starts faster
+
     fs = positive("fs_hz", fs_hz)
     seg = positive("segment_s", segment_s)
     xa = np.asarray(x, dtype=np.float64).reshape(-1)

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import signal
 
 from haptic_dob.validation import positive
 
@@ -48,6 +47,8 @@ def envelope_growth(
         stop_amplitude: end the fit where the envelope first exceeds this (signal units).
         edge_s: time trimmed at each end against the Hilbert transform's edge effects (s).
     """
+    from scipy import signal  # on use: a node process that never analyses starts faster
+
     fs = positive("fs_hz", fs_hz)
     xa = np.asarray(x, dtype=np.float64).reshape(-1)
     if xa.size < 16 or not np.all(np.isfinite(xa)):
@@ -105,6 +106,8 @@ def perturbation_response(
     0.2 s before the pulse means the contact itself started a sustained oscillation: the wall
     vibrates and its growth is not measured (NaN).
     """
+    from scipy import signal  # on use: a node process that never analyses starts faster
+
     fs = positive("fs_hz", fs_hz)
     d = np.asarray(depth_m, dtype=np.float64).reshape(-1)
     depth = positive("static_depth_m", static_depth_m)
