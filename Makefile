@@ -1,6 +1,6 @@
 # haptic_dob: the two commands of the README, plus a few helpers.
 #   make demo       create .venv, install, run OL / CL / DOB at 800 N/m through the node graph
-#   make test       install if needed, run the whole test suite
+#   make test       install if needed, run the whole test suite (two phases, see below)
 #   make reproduce  the thesis's experiments through the node graph, report in report/
 PYTHON ?= python3
 VENV   := .venv
@@ -17,10 +17,18 @@ demo: $(STAMP)
 reproduce: $(STAMP)
 	@$(BIN)/haptic-experiment --out report
 
+# Two phases: the tests that neither talk DDS nor start node processes run on every CPU
+# (pytest-xdist, at most 4 workers); then those that do (marked dds by test/conftest.py) run one
+# at a time, alone on the machine, as their timing premises ask. Both phases always run.
 # CI= : pytest prints whole assertion diffs when CI is set; one failure's diff of a 5000-sample
 # list could then hide every other failure in a truncated log
+TEST_JOBS ?= $(shell $(PYTHON) -c "import os; print(min(4, len(os.sched_getaffinity(0))))")
+PYTEST := CI= BUILD_NUMBER= $(BIN)/python -m pytest -q -rs -p no:cacheprovider
 test: $(STAMP)
-	@CI= BUILD_NUMBER= $(BIN)/python -m pytest -q -rs -p no:cacheprovider
+	@status=0; \
+	$(PYTEST) -m "not dds" -n $(TEST_JOBS) || status=$$?; \
+	$(PYTEST) -m dds || status=$$?; \
+	exit $$status
 
 install: $(STAMP)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -12,6 +13,32 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
+#: what marks a test module as one that talks DDS or starts node processes: it imports rclpy,
+#: the ROS message layer or a test helper that starts processes
+_DDS_MODULE = re.compile(
+    r"^\s*(from|import) "
+    r"(rclpy|haptic_msgs_py\.ros|rosgraph|ros2bag_session|netns_monitor|capacity)\b",
+    re.MULTILINE,
+)
+_DDS_SOURCES: dict[str, bool] = {}
+
+
+def _talks_dds(item: pytest.Item) -> bool:
+    if item.get_closest_marker("multiprocess") or "context" in getattr(item, "fixturenames", ()):
+        return True
+    path = str(item.path)
+    if path not in _DDS_SOURCES:
+        _DDS_SOURCES[path] = bool(_DDS_MODULE.search(Path(path).read_text(encoding="utf-8")))
+    return _DDS_SOURCES[path]
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark ``dds`` every test of a module that talks DDS or starts node processes (see
+    ``_DDS_MODULE``), and every test that uses the ``context`` fixture: ``make test`` runs those
+    one at a time, alone on the machine, after the others ran in parallel."""
+    for item in items:
+        if _talks_dds(item):
+            item.add_marker(pytest.mark.dds)
 
 
 @pytest.fixture
