@@ -36,7 +36,7 @@ $(STAMP): pyproject.toml constraints.txt $(INSTALLED_DATA)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	@echo "installing haptic_dob into $(VENV) (first run takes about a minute)"
 	@PIP_CONSTRAINT=$(CURDIR)/constraints.txt $(BIN)/python -m pip install -qq \
-		--disable-pip-version-check -e '.[dev]'
+		--disable-pip-version-check -e '.[dev,arms]'
 	@touch $@
 
 lint: $(STAMP)

@@ -7,11 +7,7 @@ within ``command_timeout_s``; bringing it up resumes the loop. Needs root and ``
 
 from __future__ import annotations
 
-import os
-import random
 import re
-import shutil
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -20,7 +16,8 @@ import numpy as np
 import pytest
 
 from capacity import require_realtime
-from rosgraph import Process, isolated_env
+from netns import in_ns, ip, lab_hosts
+from rosgraph import isolated_env
 from waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
@@ -31,38 +28,11 @@ BIN = Path(sys.executable).parent
 TIMEOUT_S, PERIOD_S = 0.005, 0.001
 
 
-def ip(*args: str) -> None:
-    subprocess.run(["ip", *args], check=True, capture_output=True, timeout=10)
-
-
 @pytest.fixture
 def hosts():
     """Two network namespaces joined by a veth pair; yields (nsA, nsB, ifA)."""
-    if os.geteuid() != 0 or shutil.which("ip") is None:
-        pytest.skip("needs root and iproute2 to make network namespaces")
-    tag = f"{os.getpid() % 10000}{random.randint(0, 99)}"
-    a, b, va, vb = f"hapA{tag}", f"hapB{tag}", f"hva{tag}", f"hvb{tag}"
-    subnet = random.randint(1, 250)
-    try:
-        ip("netns", "add", a)
-        ip("netns", "add", b)
-        ip("link", "add", va, "type", "veth", "peer", "name", vb)
-        ip("link", "set", va, "netns", a)
-        ip("link", "set", vb, "netns", b)
-        ip("-n", a, "addr", "add", f"10.231.{subnet}.1/24", "dev", va)
-        ip("-n", b, "addr", "add", f"10.231.{subnet}.2/24", "dev", vb)
-        for ns, dev in ((a, va), (b, vb)):
-            ip("-n", ns, "link", "set", "lo", "up")
-            ip("-n", ns, "link", "set", dev, "up")
-        yield a, b, va
-    finally:
-        for ns in (a, b):
-            subprocess.run(["ip", "netns", "pids", ns], capture_output=True)
-            subprocess.run(["ip", "netns", "del", ns], capture_output=True)
-
-
-def in_ns(ns: str, argv: list[str], env: dict[str, str], log: Path) -> Process:
-    return Process(["ip", "netns", "exec", ns, *argv], env, log)
+    with lab_hosts() as made:
+        yield made
 
 
 def read(csv: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -1,5 +1,6 @@
-"""haptic-launch of a teleoperation YAML: each node's parameters, --set, the process plan and the
-options a single loop's launch has that a teleoperation graph refuses."""
+"""haptic-launch of a teleoperation YAML: each node's parameters, --set, the process plan (each
+side's nodes in a process by default, --composed, --processes, --group, --only) and the options a
+single loop's launch has that a teleoperation graph refuses."""
 
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ from haptic_dob.cli import CliError
 from haptic_dob.launcher.options import LaunchOptions
 from haptic_dob.launcher.teleop import (
     add_teleop_recorder,
+    select_nodes,
     teleop_command,
+    teleop_groups,
     teleop_params,
     teleop_plan,
     write_teleop_params,
@@ -57,18 +60,59 @@ def test_set_names_one_node_or_both_sides(sections) -> None:
             teleop_params(sections, [bad])
 
 
-def test_composed_by_default_one_process_each_with_processes(sections, tmp_path) -> None:
+def test_one_process_by_default_a_process_per_side_or_per_node_as_asked(sections, tmp_path) -> None:
     params = teleop_params(sections, [])
     path = write_teleop_params(params, tmp_path)
     doc = yaml.safe_load(path.read_text())
     assert set(doc) == {f"/{n}" for n in params}  # full names: no wildcard to interpret
-    (one,) = teleop_plan(params, path, processes=False)
-    assert one.executable.endswith("container") and one.args[: len(params)] == list(params)
-    each = teleop_plan(params, path, processes=True)
-    assert [s.name for s in each] == list(params)
+    names = list(params)
+    assert teleop_groups(names, False, False, ()) == [names]
+    master, slave = teleop_plan(
+        params, path, teleop_groups(names, False, False, ("master", "slave"))
+    )
+    assert master.nodes == [n for n in names if n.startswith("master/")]
+    assert slave.nodes == [n for n in names if n.startswith("slave/")]
+    assert slave.executable.endswith("container") and slave.args[:4] == slave.nodes
+    (one,) = teleop_plan(params, path, teleop_groups(names, True, False, ()))
+    assert one.executable.endswith("container") and one.args[: len(params)] == names
+    each = teleop_plan(params, path, teleop_groups(names, False, True, ()))
+    assert [s.name for s in each] == names
     dev = each[-1]
     assert dev.executable.endswith("device_node")
     assert dev.args[-4:] == ["-r", "__ns:=/slave", "-r", "__node:=device_node"]
+
+
+def test_group_and_only_take_sides_or_nodes(sections, tmp_path) -> None:
+    params = teleop_params(sections, [])
+    names = list(params)
+    path = write_teleop_params(params, tmp_path)
+    groups = teleop_groups(names, False, False, ("master,slave/device_node",))
+    plan = teleop_plan(params, path, groups)
+    assert plan[-1].nodes == [*(n for n in names if n.startswith("master/")), "slave/device_node"]
+    assert [s.nodes for s in plan[:-1]] == [
+        ["slave/observer_node"],
+        ["slave/slave_controller_node"],
+        ["slave/channel_node"],
+    ]
+    assert select_nodes(names, ("slave",)) == [n for n in names if n.startswith("slave/")]
+    assert select_nodes(names, ("master/device_node", "slave")) == [
+        *(n for n in names if n.startswith("slave/") and n != "slave/device_node"),
+        "master/device_node",
+        "slave/device_node",
+    ]
+    for bad in (("arm",), ("device_node",), ("master/nosuch",)):
+        with pytest.raises(CliError, match="give a side"):
+            select_nodes(names, bad)
+    with pytest.raises(CliError, match="more than one place"):
+        teleop_groups(names, False, False, ("master", "master/device_node"))
+    with pytest.raises(CliError, match="pick one"):
+        teleop_groups(names, True, False, ("master",))
+
+
+def test_only_one_side_starts_that_sides_nodes_and_refuses_record(sections, tmp_path) -> None:
+    opts = LaunchOptions(config="teleop_sim", only=("slave",), record=str(tmp_path / "bag"))
+    with pytest.raises(CliError, match="--record with --only"):
+        teleop_command(opts, sections)
 
 
 def test_record_adds_a_recorder_of_both_sides_apart_that_both_devices_wait_for(
@@ -86,8 +130,9 @@ def test_record_adds_a_recorder_of_both_sides_apart_that_both_devices_wait_for(
         assert params[f"{ns}/device_node"]["wait_for"][-1] == RECORDER
     path = write_teleop_params(params, tmp_path)
     assert "/recorder_node" in yaml.safe_load(path.read_text())
-    for processes in (False, True):
-        plan = teleop_plan(params, path, processes)
+    names = [n for n in params if "/" in n]
+    for composed, processes in ((False, False), (True, False), (False, True)):
+        plan = teleop_plan(params, path, teleop_groups(names, composed, processes, ()))
         assert plan[0].nodes == ["recorder_node"]  # first, alone, in the root namespace
         assert plan[0].executable.endswith("recorder_node") and "__ns:=" not in plan[0].args
         assert all("recorder_node" not in s.nodes for s in plan[1:])
@@ -99,8 +144,7 @@ def test_record_adds_a_recorder_of_both_sides_apart_that_both_devices_wait_for(
     ("option", "flag"),
     [
         ({"namespace": "x"}, "--namespace"),
-        ({"only": ("device_node",)}, "--only"),
-        ({"groups": ("a,b",)}, "--group"),
+        ({"pin": True}, "--pin"),
     ],
 )
 def test_single_loop_options_are_refused(sections, option, flag) -> None:

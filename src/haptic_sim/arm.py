@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -58,6 +58,7 @@ from haptic_sim.hand import HandParams, HandReference
 from haptic_sim.sensor import ForceSensor, ForceSensorParams
 
 _ZERO3 = np.zeros(3)
+_NO_J = np.zeros((3, 0))  # the Jacobian slot of ``_last`` on the ABA path (unused there)
 
 
 def _perpendiculars(u: Vec) -> tuple[Vec, Vec]:
@@ -115,6 +116,13 @@ class SimulatedArm:
             q0 = np.array(getattr(model, "home", np.zeros(n)), dtype=np.float64)
         self._dyn = mass_and_bias(model)
         self._dyn_tip = dynamics_and_tip(model)
+        # pinocchio's ABA where the model has it (no mass matrix, no solve): the free arm and an
+        # arm under tip forces (contact, an external force), not one with a hand's mass on it
+        self._aba = bool(getattr(model, "_has_forward_dynamics", False))
+        if self._aba:
+            self._fd = cast(Any, model)._forward_dynamics
+            self._tip_motion = cast(Any, model)._tip_motion
+        self._viscous = np.asarray(getattr(model, "viscous", np.zeros(self.dof)), dtype=np.float64)
         self._coulomb, self._coulomb_eps = coulomb_smoothing(model, self._dyn, q0, self.dt_physics)
         self.effort_limits = self._limits(q0)
         #: actuator saturation per joint (N m or N), the ``SimulatedDevice`` protocol's name
@@ -219,6 +227,19 @@ class SimulatedArm:
 
     def _accel(self, q: Vec, v: Vec, tau: Vec, f_ext: Vec, ref: tuple[Vec, Vec, Vec] | None) -> Vec:
         """Joint acceleration; with tip forces also records (grip, J, J' q', f_ext) in ``_last``."""
+        if self._aba and ref is None:  # b q' + Fc tanh(q' / eps) in one go, then ABA
+            if self._coulomb is not None:
+                tau = tau - self._viscous * v - self._coulomb * np.tanh(v / self._coulomb_eps)
+            else:
+                tau = tau - self._viscous * v
+            if not self._needs_tip:
+                a: Vec = self._fd(q, v, tau, None)
+                return a
+            if self._contact is not None:
+                f_ext = f_ext + self._contact(*self._tip_motion(q, v))
+            self._last = (_ZERO3, _NO_J, _ZERO3, f_ext)  # J unused without a hand's grip
+            a = self._fd(q, v, tau, f_ext)
+            return a
         if self._coulomb is not None:  # the model's Fc sgn(q') -> Fc tanh(q' / eps)
             fc = self._coulomb
             tau = tau - fc * (np.tanh(v / self._coulomb_eps) - np.sign(v))

@@ -20,7 +20,8 @@ hosts (``ROS_STATIC_PEERS``), and ``--only`` starts a subset: the device on one 
 on another (see docs/running.md, "Lab network and security").
 
 A teleoperation YAML (``/master/...`` and ``/slave/...`` sections) starts the two sides' nodes in
-their namespaces, composed in one process by default (``haptic_dob.launcher.teleop``).
+their namespaces, all in one process by default; ``--group`` and ``--only`` take sides there
+(``haptic_dob.launcher.teleop``).
 """
 
 from __future__ import annotations
@@ -105,7 +106,8 @@ def build_parser() -> ArgumentParser:
         action="append",
         default=[],
         metavar="NODE,NODE[,...]",
-        help="these nodes share a process (repeatable; nodes in no group run alone)",
+        help="these nodes share a process (repeatable; nodes in no group run alone; for a "
+        "teleoperation graph: master, slave or NS/NODE)",
     )
     p.add_argument(
         "--set",
@@ -136,7 +138,8 @@ def build_parser() -> ArgumentParser:
         "--only",
         default="",
         metavar="NODE[,NODE...]",
-        help="start only these nodes of the config (split a session across hosts)",
+        help="start only these nodes of the config (split a session across hosts; for a "
+        "teleoperation graph: master, slave or NS/NODE)",
     )
     p.add_argument(
         "--network",

@@ -1,15 +1,18 @@
 """``haptic-launch`` of a teleoperation YAML: the master's and the slave's nodes in their
-namespaces (``haptic_dob.teleop.graph``), composed in one process by default.
+namespaces (``haptic_dob.teleop.graph``), all in one process by default.
 
 A YAML with ``/master/...`` or ``/slave/...`` sections is a teleoperation graph: each node's
 parameters are its sections overlaid (``node_values``), written to a params file under the
 node's full name; ``--set NS/NODE:PARAM=VALUE`` overrides one node's, ``**/NODE:`` the node of
-both sides. ``--composed`` (the default) runs all nodes in one container (their messages handed
-over in process), ``--processes`` one process each. ``--record BAG`` adds a ``recorder_node`` in
-the root namespace, in a process of its own: it records both sides' topics and the channel's
+both sides. ``--composed`` (the default) runs all nodes in one container (every message, the
+channel's link too, handed over in process), ``--processes`` one process each, ``--group`` names
+groups (``master``, ``slave`` or ``NS/NODE`` items: ``--group master --group slave`` gives each
+side a process, each device a CPU). ``--only`` starts the named sides or nodes: the slave on
+another host, with ``--network subnet``. ``--record BAG`` adds a ``recorder_node`` in the root
+namespace, in a process of its own: it records both sides' topics and the channel's
 (``recorded_topics``), snapshots the nodes of ``/master`` and ``/slave``, and both devices wait
 for it (``haptic-teleop --bag BAG`` analyses the bag). The options of a single loop's launch
-(``--namespace``, ``--group``, ``--only``, ``--pin``, ``--cpu-latency``) are refused.
+``--namespace``, ``--pin`` and ``--cpu-latency`` are refused.
 """
 
 from __future__ import annotations
@@ -104,29 +107,76 @@ def add_teleop_recorder(params: dict[str, dict[str, Any]], output: str, storage:
         device["wait_for"] = [*device.get("wait_for", default), RECORDER]
 
 
-def teleop_plan(params: Mapping[str, Any], params_file: Path, processes: bool) -> list[ProcessSpec]:
-    """One container for every node, or (``processes``) a process per node, devices last; a
-    recorder (in the root namespace) in a process of its own, first."""
+def _expand(item: str, names: Sequence[str], flag: str) -> list[str]:
+    """A side (``master``, ``slave``) -> its nodes; ``NS/NODE`` -> itself; ``CliError`` else."""
+    if item in NAMESPACES:
+        return [n for n in names if n.startswith(f"{item}/")]
+    if item in names:
+        return [item]
+    raise CliError(
+        f"{flag} names {item!r}: give a side (master, slave) or a node of the graph "
+        f"({', '.join(names)})"
+    )
+
+
+def select_nodes(names: Sequence[str], only: Sequence[str]) -> list[str]:
+    """``--only``: the named sides' or nodes' (all when empty), in start order."""
+    if not only:
+        return list(names)
+    chosen = {n for item in only for n in _expand(item, names, "--only")}
+    return [n for n in names if n in chosen]
+
+
+def teleop_groups(
+    names: Sequence[str], composed: bool, processes: bool, given: Sequence[str]
+) -> list[list[str]]:
+    """Which nodes share a process: ``--processes`` none, ``--group`` (``master``, ``slave`` or
+    ``NS/NODE`` items) the named ones, else (``--composed``, the default) all."""
+    if sum((composed, processes, bool(given))) > 1:
+        raise CliError("--composed, --processes and --group are different choices: pick one")
+    if processes:
+        return []
+    if not given:
+        return [list(names)]
+    groups: list[list[str]] = []
+    seen: set[str] = set()
+    for text in given:
+        group = [n for item in text.split(",") if item for n in _expand(item, names, "--group")]
+        twice = sorted({n for n in group if n in seen or group.count(n) > 1})
+        if twice:
+            raise CliError(f"--group: {', '.join(twice)} named in more than one place")
+        seen.update(group)
+        groups.append(group)
+    return groups
+
+
+def teleop_plan(
+    params: Mapping[str, Any], params_file: Path, groups: Sequence[Sequence[str]]
+) -> list[ProcessSpec]:
+    """The processes, in start order: a recorder (root namespace) first and alone, then each
+    group in one container and every other node alone, the devices' processes last."""
     ros = ["--ros-args", "--params-file", str(params_file)]
     out = []
     names = [n for n in params if "/" in n]
     for name in (n for n in params if "/" not in n):
         entry = NODES[name]
         out.append(ProcessSpec(name, [name], executable(entry.package, entry.executable), ros))
-    if not processes:
-        return [*out, ProcessSpec(", ".join(names), names, executable(*CONTAINER), [*names, *ros])]
-    for name in names:
-        ns, _, node = name.partition("/")
-        entry = NODES[node]
-        args = [*ros, "-r", f"__ns:=/{ns}", "-r", f"__node:={node}"]
-        out.append(ProcessSpec(name, [name], executable(entry.package, entry.executable), args))
+    shared = [[n for n in names if n in g] for g in groups]
+    shared = [g for g in shared if len(g) > 1]
+    for name in names:  # a process starts where its last node would: devices last
+        group = next((g for g in shared if name in g), None)
+        if group is None:
+            ns, _, node = name.partition("/")
+            entry = NODES[node]
+            args = [*ros, "-r", f"__ns:=/{ns}", "-r", f"__node:={node}"]
+            out.append(ProcessSpec(name, [name], executable(entry.package, entry.executable), args))
+        elif name == group[-1]:
+            out.append(ProcessSpec(", ".join(group), group, executable(*CONTAINER), [*group, *ros]))
     return out
 
 
 REFUSED = {
     "namespace": "--namespace",
-    "groups": "--group",
-    "only": "--only",
     "pin": "--pin",
     "cpu_latency_us": "--cpu-latency",
 }
@@ -140,18 +190,24 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
             f"{', '.join(given)}: not for a teleoperation graph (its namespaces are "
             "/master and /slave)"
         )
-    if opts.composed and opts.processes:
-        raise CliError("--composed and --processes are different choices: pick one")
     params = teleop_params(sections, opts.sets)
+    names = select_nodes([n for n in params if "/" in n], opts.only)
+    groups = teleop_groups(names, opts.composed, opts.processes, opts.groups)
+    if opts.record and opts.only:
+        raise CliError(
+            "--record with --only: both sides' devices wait for the recorder, so record where "
+            "the whole graph starts (or run haptic-record and add it to each device's wait_for)"
+        )
     if opts.record:
         add_teleop_recorder(params, opts.record, opts.record_storage)
+    params = {n: v for n, v in params.items() if n in names or "/" not in n}
     net = network_env(opts.network, opts.peers)
     if opts.rt_priority is not None:
         set_rt_priority(opts.rt_priority)
     if opts.executor:
         net["HAPTIC_DOB_EXECUTOR"] = opts.executor
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
-        specs = teleop_plan(params, write_teleop_params(params, Path(tmp)), opts.processes)
+        specs = teleop_plan(params, write_teleop_params(params, Path(tmp)), groups)
         for spec in specs:
             if len(spec.nodes) > 1:
                 print(f"haptic-launch: {spec.name} in one process", file=sys.stderr)

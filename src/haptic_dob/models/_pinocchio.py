@@ -284,6 +284,33 @@ class PinocchioModel(DeviceModel):
             h += self._friction(qd)
         return D, h, p, J, acc
 
+    # --- forward dynamics for the simulator (ABA: no mass matrix, no linear solve) ------------
+    @property
+    def _has_forward_dynamics(self) -> bool:
+        """Whether ``_tip_motion`` and ``_forward_dynamics`` apply: our coordinates are
+        pinocchio's velocity coordinates (no selection, no mimic joint)."""
+        return self._S is None and not self._mimic
+
+    def _tip_motion(self, q: Vec, qd: Vec) -> tuple[Vec, Vec]:
+        """End-effector point p (m) and its velocity ``J q'`` (m/s), from one kinematics pass."""
+        m, d, fid = self._model, self._data, self._fid
+        pin.forwardKinematics(m, d, self._conf(q), qd)
+        p = pin.updateFramePlacement(m, d, fid).translation.copy()
+        return p, pin.getFrameVelocity(m, d, fid, _LWA).linear.copy()
+
+    def _forward_dynamics(self, q: Vec, qd: Vec, tau: Vec, f_tip: Vec | None) -> Vec:
+        """Rigid-body joint acceleration (rad/s^2) under effort ``tau`` and a force ``f_tip`` (N,
+        world frame) at the end effector, friction left to the caller: ``D^-1 (tau - C q' - G +
+        J^T f)`` by pinocchio's ABA, no mass matrix and no solve (the simulated arm's integrator
+        calls it 8 times a sample)."""
+        m, d = self._model, self._data
+        qt = self._conf(q)
+        if f_tip is not None and (f_tip[0] != 0.0 or f_tip[1] != 0.0 or f_tip[2] != 0.0):
+            J = pin.computeFrameJacobian(m, d, qt, self._fid, _LWA)[:3]
+            tau = tau + J.T @ f_tip
+        a: Vec = pin.aba(m, d, qt, qd, tau).copy()
+        return a
+
     def potential_energy(self, q: Vec) -> float:
         """Gravitational potential energy (J) of the device at ``q`` (0 without gravity)."""
         m, d = self._model, self._data
