@@ -17,17 +17,21 @@ demo: $(STAMP)
 reproduce: $(STAMP)
 	@$(BIN)/haptic-experiment --out report
 
-# Two phases: the tests that neither talk DDS nor start node processes run on every CPU
-# (pytest-xdist, at most 4 workers); then those that do (marked dds by test/conftest.py) run one
-# at a time, alone on the machine, as their timing premises ask. Both phases always run.
+# Three phases: the tests that neither talk DDS nor start node processes run on every CPU
+# (pytest-xdist, at most 4 workers); then those that do (marked dds by test/conftest.py), bounded
+# in samples, two at a time (one on one CPU), each on a domain id of its worker's; then the ones
+# whose premise is real time (marked alone) one at a time, alone on the machine, as they ask.
+# Every phase always runs; the exit code is the worst.
 # CI= : pytest prints whole assertion diffs when CI is set; one failure's diff of a 5000-sample
 # list could then hide every other failure in a truncated log
 TEST_JOBS ?= $(shell $(PYTHON) -c "import os; print(min(4, len(os.sched_getaffinity(0))))")
+DDS_JOBS ?= $(shell $(PYTHON) -c "import os; print(min(2, len(os.sched_getaffinity(0))))")
 PYTEST := CI= BUILD_NUMBER= $(BIN)/python -m pytest -q -rs -p no:cacheprovider
 test: $(STAMP)
 	@status=0; \
 	$(PYTEST) -m "not dds" -n $(TEST_JOBS) || status=$$?; \
-	$(PYTEST) -m dds || status=$$?; \
+	$(PYTEST) -m "dds and not alone" -n $(DDS_JOBS) || status=$$?; \
+	$(PYTEST) -m alone || status=$$?; \
 	exit $$status
 
 install: $(STAMP)

@@ -47,12 +47,16 @@ def lockstep_rtf(
     return _measured[key]
 
 
-def teleop_lockstep_rtf() -> float:
-    """The lockstep real-time factor of the teleoperation graph (teleop_sim: both sides' nodes
-    composed in one process), the slower device's; measured once."""
-    key = (("teleop_sim",),)
+def teleop_lockstep_rtf(composed: bool = True) -> float:
+    """The lockstep real-time factor of the teleoperation graph, the slower device's, each
+    channel end using what has come as in real time (so that each side runs at its own pace);
+    measured once per layout: ``composed`` every node in one process, else a process per side
+    (real time's default)."""
+    key = (("teleop_sim", "composed" if composed else "sides"),)
     if key not in _measured:
         argv = [str(BIN / "haptic-launch"), str(ROOT / "config" / "teleop_sim.yaml")]
+        argv += ["--composed"] if composed else ["--group", "master", "--group", "slave"]
+        argv += ["--set", "**/channel_node:wait_for_peer=false"]
         argv += ["--set", f"**/device_node:duration_s={MEASURE_S}"]
         _measured[key] = _probe(argv)
     return _measured[key]
@@ -91,14 +95,16 @@ def require_realtime(
     return rtf
 
 
-def require_realtime_teleop() -> float:
-    """Skip the calling test unless this machine turns the composed teleoperation graph over at
-    ``REQUIRED_RTF`` times real time or faster in lockstep (now); returns the figure."""
-    rtf = teleop_lockstep_rtf()
+def require_realtime_teleop(composed: bool = True) -> float:
+    """Skip the calling test unless this machine turns the teleoperation graph in that layout
+    (``teleop_lockstep_rtf``) over at ``REQUIRED_RTF`` times real time or faster in lockstep
+    (now); returns the slower side's figure."""
+    rtf = teleop_lockstep_rtf(composed)
     if rtf < REQUIRED_RTF:
+        layout = "all in one process" if composed else "a process per side"
         pytest.skip(
-            f"this machine turns the teleoperation graph (both sides composed in one process) "
-            f"over at {rtf:.2f}x real time in lockstep, measured now; real time at 1 kHz needs "
+            f"this machine turns the teleoperation graph ({layout}) over at {rtf:.2f}x real time "
+            f"in lockstep (the slower side), measured now; real time at 1 kHz needs "
             f"{REQUIRED_RTF:g}x"
         )
     return rtf

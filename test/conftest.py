@@ -21,6 +21,10 @@ _DDS_MODULE = re.compile(
     re.MULTILINE,
 )
 _DDS_SOURCES: dict[str, bool] = {}
+#: what marks a DDS test module as one to run alone on the machine: its premise is real time at
+#: 1 kHz, so it measures what the machine can carry (``capacity``) and that must be the machine's
+_ALONE_MODULE = re.compile(r"^\s*(from|import) capacity\b", re.MULTILINE)
+_ALONE_SOURCES: dict[str, bool] = {}
 
 
 def _talks_dds(item: pytest.Item) -> bool:
@@ -32,13 +36,25 @@ def _talks_dds(item: pytest.Item) -> bool:
     return _DDS_SOURCES[path]
 
 
+def _alone(item: pytest.Item) -> bool:
+    path = str(item.path)
+    if path not in _ALONE_SOURCES:
+        text = Path(path).read_text(encoding="utf-8")
+        _ALONE_SOURCES[path] = bool(_ALONE_MODULE.search(text))
+    return _ALONE_SOURCES[path]
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Mark ``dds`` every test of a module that talks DDS or starts node processes (see
-    ``_DDS_MODULE``), and every test that uses the ``context`` fixture: ``make test`` runs those
-    one at a time, alone on the machine, after the others ran in parallel."""
+    ``_DDS_MODULE``), and every test that uses the ``context`` fixture; of those, mark ``alone``
+    the ones whose module has real time as a premise (``_ALONE_MODULE``). ``make test`` runs the
+    others first on every CPU, then the ``dds`` ones two at a time, then the ``alone`` ones one at
+    a time, alone on the machine."""
     for item in items:
         if _talks_dds(item):
             item.add_marker(pytest.mark.dds)
+            if _alone(item):
+                item.add_marker(pytest.mark.alone)
 
 
 @pytest.fixture

@@ -25,10 +25,20 @@ from waits import wait_until
 BIN = Path(sys.executable).parent
 
 
+def random_domain() -> int:
+    """A random ROS domain id in 1-100; under pytest-xdist from this worker's share of that range,
+    so that tests running at once never meet on one domain."""
+    count = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    worker = int(os.environ.get("PYTEST_XDIST_WORKER", "gw0")[2:] or 0)
+    span = 100 // max(1, min(count, 100))
+    return random.randint(1 + worker * span, (worker + 1) * span)
+
+
 def isolated_env(domain: int | None = None) -> dict[str, str]:
-    """This environment with a random domain id and localhost-only discovery."""
+    """This environment with a random domain id (``random_domain``) and localhost-only
+    discovery."""
     env = dict(os.environ)
-    env["ROS_DOMAIN_ID"] = str(domain if domain is not None else random.randint(1, 100))
+    env["ROS_DOMAIN_ID"] = str(domain if domain is not None else random_domain())
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     env.pop("ROS_STATIC_PEERS", None)
     return env

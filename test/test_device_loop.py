@@ -335,3 +335,18 @@ def test_wait_for_names_a_node_here_or_anywhere_by_its_full_name() -> None:
         "rosbag2_recorder"
     ]
     assert missing_nodes(["/rosbag2_recorder"], graph[:1], "/slide1") == ["/rosbag2_recorder"]
+
+
+def test_start_with_names_devices_fully_qualified_and_waits_for_their_joint_states() -> None:
+    """``start_with``: a device to start the clock with counts as built once its
+    ``joint_states`` publisher is up; a name that is not fully qualified is refused."""
+    from haptic_sim.device_settings import start_topics
+
+    assert start_topics(["/slave/device_node", "/a/b/dev"]) == [
+        "/slave/joint_states",
+        "/a/b/joint_states",
+    ]
+    assert start_topics(["/device_node"]) == ["/joint_states"]
+    for bad in ("slave/device_node", "device_node", "/slave/"):
+        with pytest.raises(ValueError, match="fully qualified"):
+            start_topics([bad])

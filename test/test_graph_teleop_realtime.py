@@ -1,18 +1,21 @@
-"""The teleoperation graph in real time at 1 kHz, composed in one process (``haptic-launch
-teleop_sim --set '**/device_node:clock_mode=realtime'``): the loop closes over the channel, and
+"""The teleoperation graph in real time at 1 kHz (``haptic-launch teleop_sim --set
+'**/device_node:clock_mode=realtime'``), a process per side (the default in real time) and all in
+one process (``--composed``): the loop closes over the channel, and
 when the link dies (``channel.cut_at_s``) the master renders exactly zero force within the
 watchdog and the slave holds where it is. Bounds in samples.
 
 In real time each device ticks on its own clock, so the two sides' samples are apart by their
-start-up skew (a device starts when its own side is up): the slave's last message before the cut
+start-up skew (each device starts once its own side is up and the other's device is built,
+``start_with``, plus what each still waits for): the slave's last message before the cut
 reaches the master at the master's sample ``C - 1 + max(delay, lag)``, where ``lag`` is how many
-samples the slave is behind the master at the cut (measured here from when the test's readers got
-both sides' link messages). The master's end then goes silent ``timeout`` samples later (20 ms,
-21 samples), as the batch run's does; the slave's end likewise with the master's lag. The upper
-bound allows ``SLACK`` samples for the hand-over and the lag's measurement.
+samples the slave is behind the master when it sends that message (measured here from when the
+test's readers got both sides' link messages). The master's end then goes silent ``timeout``
+samples later (20 ms, 21 samples), as the batch run's does; the slave's end likewise with the
+master's lag. The upper bound allows ``SLACK`` samples for the hand-over and the lag's
+measurement.
 
-Skips where the suite's capacity measurement says this machine cannot turn the composed graph
-over fast enough for real time at 1 kHz now (``capacity.require_realtime_teleop``).
+Each layout skips where the suite's capacity measurement says this machine cannot turn it over
+fast enough for real time at 1 kHz now (``capacity.require_realtime_teleop``).
 """
 
 from __future__ import annotations
@@ -51,10 +54,12 @@ def link(col: Collector, topic: str) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 
 def lag_at(k_a: np.ndarray, t_a: np.ndarray, k_b: np.ndarray, t_b: np.ndarray) -> int:
-    """How many samples side b is behind side a when a's message of sample ``CUT`` came."""
-    at = t_a[np.flatnonzero(k_a == CUT)[0]]
-    newest_b = k_b[: np.searchsorted(t_b, at, side="right")].max()
-    return int(CUT - newest_b)
+    """How many samples side b is behind side a when b's last message before the cut (sample
+    ``CUT - 1``) came: a's newest sample then, less ``CUT - 1`` (negative when b is ahead). A side
+    slower than real time keeps falling behind, so this is the lag that says when a gets it."""
+    at = t_b[np.flatnonzero(k_b == CUT - 1)[0]]
+    newest_a = k_a[: np.searchsorted(t_a, at, side="right")].max()
+    return int(newest_a - (CUT - 1))
 
 
 def vectors(col: Collector, topic: str) -> dict[int, np.ndarray]:
@@ -66,8 +71,11 @@ def vectors(col: Collector, topic: str) -> dict[int, np.ndarray]:
     return out
 
 
-def test_realtime_teleop_closes_the_loop_and_falls_back_on_a_dead_link(root, tmp_path) -> None:
-    require_realtime_teleop()
+@pytest.mark.parametrize("layout", [[], ["--composed"]], ids=["a-process-per-side", "composed"])
+def test_realtime_teleop_closes_the_loop_and_falls_back_on_a_dead_link(
+    root, tmp_path, layout
+) -> None:
+    require_realtime_teleop(composed=bool(layout))
     env = isolated_env()
     cols = {
         "master": Collector(
@@ -89,7 +97,8 @@ def test_realtime_teleop_closes_the_loop_and_falls_back_on_a_dead_link(root, tmp
     ]
     sets += [f"{ns}/device_node:wait_for={w}" for ns, w in WAIT.items()]
     sets += [f"{ns}/device_node:stats_file={p}" for ns, p in stats.items()]
-    graph = launch(str(root / "config" / "teleop_sim.yaml"), env, sets, tmp_path / "launch.log")
+    config = str(root / "config" / "teleop_sim.yaml")
+    graph = launch(config, env, sets, tmp_path / "launch.log", layout)
     try:
         assert graph.wait(120) == 0, graph.output()
     finally:

@@ -88,6 +88,15 @@ def schedule_specs() -> list[ParamSpec]:
             read_only=True,
         ),
         ParamSpec(
+            "start_with",
+            [],
+            "devices this one starts its clock with, fully qualified (/slave/device_node): "
+            "sample 0 waits until each has built its simulation (its joint_states publisher is "
+            "up), so that the two sides of a teleoperation in real time tick from the same moment",
+            read_only=True,
+            items=str,
+        ),
+        ParamSpec(
             "start_delay_s",
             0.5,
             "settle time between the wait_for graph being up and "
@@ -136,6 +145,19 @@ class DeviceLoopSettings:
             values["start_delay_s"],
             tuple(values["wait_for"]),
         )
+
+
+def start_topics(start_with: Iterable[str]) -> list[str]:
+    """The ``joint_states`` topic of each ``start_with`` device (its node's namespace); a name
+    that is not fully qualified raises ``ValueError``."""
+    out = []
+    for name in start_with:
+        if not name.startswith("/") or name.endswith("/"):
+            raise ValueError(
+                f"start_with names devices fully qualified (/ns/device_node): {name!r}"
+            )
+        out.append(f"{name.rpartition('/')[0]}/joint_states")
+    return out
 
 
 def missing_nodes(

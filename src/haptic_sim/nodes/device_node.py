@@ -59,7 +59,12 @@ from haptic_msgs_py.values import JointSample, Stamp, StampedVector
 from haptic_sim.cycle_stats import CycleStats
 from haptic_sim.device import DeviceSample
 from haptic_sim.device_loop import DeviceLoop
-from haptic_sim.device_settings import DeviceLoopSettings, device_node_specs, missing_nodes
+from haptic_sim.device_settings import (
+    DeviceLoopSettings,
+    device_node_specs,
+    missing_nodes,
+    start_topics,
+)
 from haptic_sim.factory import build_device
 
 
@@ -75,6 +80,7 @@ class DeviceNode(LoopNode):
         super().__init__(name, context=context, namespace=namespace)
         self.params = ParameterTable(self, device_node_specs())
         v = self.params.values
+        self._start_with = start_topics(v["start_with"])
         self.device = build_device(v)
         self.dof = self.device.dof
         self.period_ns = self.device.period_ns
@@ -164,6 +170,9 @@ class DeviceNode(LoopNode):
         missing = missing_nodes(wait_for, self.get_node_names_and_namespaces(), ns)
         if missing:
             return f"node{'s' if len(missing) > 1 else ''} {', '.join(missing)} in {ns}"
+        for topic in self._start_with:  # a device to start with: built once it publishes
+            if self.count_publishers(topic) < 1:
+                return f"the device publishing {topic} (start_with)"
         for pub in self._bus.publishers():  # this node's and any composed with it
             if pub.readers < self.count_subscribers(pub.topic):
                 return f"the subscribers of {pub.topic} to match"
