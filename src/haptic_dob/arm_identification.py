@@ -1,9 +1,13 @@
-"""Joint friction of an arm from its joint states: ``tau - RNEA(q, q', q'') = b q' + Fc sgn(q')``.
+"""Joint friction of an arm from its joint states:
+``tau - RNEA(q, q', q'') = b q' + Fc tanh(q' / v_c)`` (``Fc sgn(q')`` for ``v_c = 0``).
 
 ROS-free (numpy/scipy/the model's pinocchio). The rigid-body part comes from the arm's model (its
 URDF's masses and inertias, friction left out); what the measured effort has beyond it is fitted
 per joint as viscous plus Coulomb friction by least squares, with the filters the 1-DOF
-identification uses (``haptic_dob.fit_filters``).
+identification uses (``haptic_dob.fit_filters``). The speed ``v_c`` over which the Coulomb
+friction turns is found by a search over a grid (least squares for ``b`` and ``Fc`` at each
+value, the smallest residual wins), on every sample but the filters' ends, slow ones included:
+they are where it shows (a sign model errs by up to ``2 Fc`` there, at every reversal).
 
 The fit uses the first ``1 - holdout`` of the record; the rest is held out: each joint reports
 the RMS of what the rigid-body model leaves unexplained there without friction and with the
@@ -37,6 +41,7 @@ class JointFriction:
     samples: int  # samples the fit used
     heldout_rms_rigid: float  # RMS of effort - rigid-body model on held-out moving samples
     heldout_rms: float  # the same with the fitted friction
+    coulomb_speed: float = 0.0  # rad/s (or m/s): the Coulomb term turns over it; 0 = a sign
 
 
 @dataclass(frozen=True)
@@ -47,11 +52,17 @@ class ArmFrictionFit:
     holdout: float  # the part of the record held out (its end)
 
     def as_params(self) -> dict[str, list[float]]:
-        """``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``, one value per joint."""
+        """``urdf.viscous_n_m_s_per_rad``, ``urdf.coulomb_n_m`` and
+        ``urdf.coulomb_speed_rad_per_s``, one value per joint."""
         return {
             "urdf.viscous_n_m_s_per_rad": [j.viscous for j in self.joints],
             "urdf.coulomb_n_m": [j.coulomb for j in self.joints],
+            "urdf.coulomb_speed_rad_per_s": [j.coulomb_speed for j in self.joints],
         }
+
+
+#: the speeds over which the Coulomb friction may turn (rad/s or m/s); 0 is a sign
+COULOMB_SPEEDS = (0.0, *np.logspace(-4.0, -0.7, 67).tolist())
 
 
 def identify_arm_friction(
@@ -67,7 +78,8 @@ def identify_arm_friction(
     """Fit each joint's viscous and Coulomb friction on the effort ``rigid`` leaves unexplained.
 
     ``position`` and ``effort`` are (N, dof) in ``rigid``'s joint order (``names``); the effort of
-    sample k was applied over [k-1, k). ``min_speed`` (rad/s or m/s): slower samples are left out.
+    sample k was applied over [k-1, k). ``min_speed`` (rad/s or m/s): the held-out residuals, and
+    the check that each joint moved enough, count only faster samples.
     """
     n, dof = position.shape
     if dof != rigid.dof or effort.shape != position.shape:
@@ -87,21 +99,31 @@ def identify_arm_friction(
     rigid_effort = np.array([rigid.inverse_dynamics(x[k], v[k], a[k]) for k in range(n)])
     r = f.effort(effort) - rigid_effort  # what friction (and anything not modelled) explains
     v_light = f.light_velocity(position)
-    s = f.coulomb_term(v_light)
     split = int((1.0 - holdout) * n)
+    edge = 2 * f.window
+    every = np.arange(edge, split, f.step)  # slow samples too: the turn of Coulomb shows there
+    terms = [
+        f.coulomb_term(v_light) if c == 0.0 else f.smooth(np.tanh(v_light / c))
+        for c in COULOMB_SPEEDS
+    ]
     out = []
     for j, name in enumerate(names):
         usable = f.usable(v_light[:, j], min_speed)
-        fit_idx = np.flatnonzero(usable[:split])[:: f.step]
+        moving = np.flatnonzero(usable[:split])
         test_idx = np.flatnonzero(usable[split:])[:: f.step] + split
-        if len(fit_idx) < 20 or len(test_idx) < 10:
+        if len(moving) < 20 * f.step or len(test_idx) < 10:
             raise IdentificationError(
-                f"{name}: too little motion to fit ({len(fit_idx)} usable samples faster than "
-                f"{min_speed:g}/s before the held-out part, {len(test_idx)} in it)"
+                f"{name}: too little motion to fit ({len(moving) // f.step} usable samples faster "
+                f"than {min_speed:g}/s before the held-out part, {len(test_idx)} in it)"
             )
-        theta, std, _ = fit(
-            np.column_stack([v[fit_idx, j], s[fit_idx, j]]), r[fit_idx, j], str(name)
-        )
+        best = None
+        for c, s in zip(COULOMB_SPEEDS, terms, strict=True):
+            X = np.column_stack([v[every, j], s[every, j]])
+            theta, std, rms = fit(X, r[every, j], str(name))
+            if best is None or rms < best[3]:
+                best = (c, theta, std, rms, s)
+        assert best is not None
+        c, theta, std, _, s = best
         rt = r[test_idx, j]
         pred = np.column_stack([v[test_idx, j], s[test_idx, j]]) @ theta
         out.append(
@@ -111,9 +133,10 @@ def identify_arm_friction(
                 physical("Coulomb friction", float(theta[1]), float(std[1]), str(name)),
                 float(std[0]),
                 float(std[1]),
-                len(fit_idx),
+                len(every),
                 math.sqrt(float(np.mean(rt * rt))),
                 math.sqrt(float(np.mean((rt - pred) ** 2))),
+                float(c),
             )
         )
     return ArmFrictionFit(out, holdout)

@@ -76,13 +76,14 @@ def arm_table(fit: ArmFrictionFit, bag: str) -> str:
     held = round(100 * fit.holdout)
     rows = [
         f"bag {bag}: joint friction beyond the URDF's rigid body (held out: the last {held} %)",
-        "joint                viscous (N m s/rad)   Coulomb (N m)       held-out RMS (N m): "
-        "rigid -> with friction",
+        "joint                viscous (N m s/rad)   Coulomb (N m)       turns over (rad/s)  "
+        "held-out RMS (N m): rigid -> with friction",
     ]
     for j in fit.joints:
+        turn = f"{j.coulomb_speed:.4g}" if j.coulomb_speed > 0.0 else "- (a sign)"
         rows.append(
             f"{j.joint:<20} {plus_minus(j.viscous, j.viscous_std, '.4f'):<21} "
-            f"{plus_minus(j.coulomb, j.coulomb_std, '.4f'):<19} "
+            f"{plus_minus(j.coulomb, j.coulomb_std, '.4f'):<19} {turn:<19} "
             f"{j.heldout_rms_rigid:.4f} -> {j.heldout_rms:.4f}"
         )
     return "\n".join(rows)

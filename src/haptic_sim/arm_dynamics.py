@@ -58,7 +58,14 @@ def coulomb_smoothing(
 ) -> tuple[Vec | None, Vec]:
     """The model's Coulomb friction (None without) and, per joint, the speed ``eps`` where the
     slope ``Fc / eps`` times the physics step ``h`` (s) is half the joint's inertia at ``q0``
-    (at least 1 mrad/s)."""
+    (at least 1 mrad/s); ``ValueError`` for a model whose Coulomb friction turns over a speed of
+    its own (``coulomb_speed``, an observer's)."""
+    speed = getattr(model, "coulomb_speed", None)
+    if speed is not None and np.any(np.asarray(speed) > 0.0):
+        raise ValueError(
+            "a simulated arm smooths its Coulomb friction over its physics step: "
+            "urdf.coulomb_speed_rad_per_s is for an observer's model, leave it [] here"
+        )
     fc = getattr(model, "coulomb", None)
     if fc is None or not np.any(np.asarray(fc) > 0.0):
         return None, np.ones(model.dof)

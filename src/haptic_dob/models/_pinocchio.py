@@ -100,6 +100,8 @@ class PinocchioModel(DeviceModel):
         viscous: viscous joint friction b (N m s/rad or N s/m), scalar or per joint, >= 0.
         coulomb: Coulomb joint friction Fc (N m or N), scalar or per joint, >= 0: the joint
             friction is ``b q' + Fc sgn(q')``.
+        coulomb_speed: v_c (rad/s or m/s), scalar or per joint, >= 0: where > 0 the Coulomb
+            term is ``Fc tanh(q' / v_c)`` (a friction that turns over a speed, as identified).
     """
 
     def __init__(
@@ -112,6 +114,7 @@ class PinocchioModel(DeviceModel):
         gravity: bool = True,
         viscous: float | Sequence[float] = 0.0,
         coulomb: float | Sequence[float] = 0.0,
+        coulomb_speed: float | Sequence[float] = 0.0,
     ) -> None:
         self.dof = len(joint_names)
         self.joint_names = tuple(joint_names)
@@ -141,8 +144,14 @@ class PinocchioModel(DeviceModel):
         )
         self.viscous = self._per_joint("viscous", viscous)
         self.coulomb = self._per_joint("coulomb", coulomb)
+        self.coulomb_speed = self._per_joint("coulomb_speed", coulomb_speed)
         self._has_coulomb = bool(np.any(self.coulomb > 0.0))
         self._has_friction = bool(np.any(self.viscous > 0.0) or self._has_coulomb)
+        # Fc tanh(q' / v_c) where v_c > 0 (1 / v_c here, 0 elsewhere), Fc sgn(q') elsewhere
+        self._smooth = self.coulomb_speed > 0.0
+        speed = np.where(self._smooth, self.coulomb_speed, 1.0)
+        self._inv_speed = np.where(self._smooth, 1.0 / speed, 0.0)
+        self._any_smooth = bool(np.any(self._smooth & (self.coulomb > 0.0)))
 
     def _per_joint(self, name: str, value: float | Sequence[float]) -> Vec:
         """A scalar for every joint, or one value per joint; finite and >= 0."""
@@ -230,7 +239,9 @@ class PinocchioModel(DeviceModel):
 
     def _friction(self, qd: Vec) -> Vec:
         f: Vec = self.viscous * qd
-        if self._has_coulomb:
+        if self._any_smooth:
+            f += self.coulomb * np.where(self._smooth, np.tanh(qd * self._inv_speed), np.sign(qd))
+        elif self._has_coulomb:
             f += self.coulomb * np.sign(qd)
         return f
 

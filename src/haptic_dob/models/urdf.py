@@ -32,6 +32,8 @@ class UrdfModel(PinocchioModel):
             joint's ``<dynamics damping>`` from the URDF (0 where it has none).
         coulomb: Coulomb joint friction (N m or N), scalar or per joint; None: each joint's
             ``<dynamics friction>`` from the URDF.
+        coulomb_speed: the speed (rad/s or m/s) over which the Coulomb friction turns, scalar or
+            per joint: ``Fc tanh(q' / v_c)``; 0 (the default): ``Fc sgn(q')``.
 
     Raises ``ValueError`` with a clear message for a bad URDF, an unknown frame or joint, or a
     joint that cannot be a coordinate (floating, planar, a mimic joint named in ``joint_names``).
@@ -46,6 +48,7 @@ class UrdfModel(PinocchioModel):
         gravity: bool = True,
         viscous: float | Sequence[float] | None = None,
         coulomb: float | Sequence[float] | None = None,
+        coulomb_speed: float | Sequence[float] = 0.0,
     ) -> None:
         if not str(tip_frame):
             raise ValueError("tip_frame must name a frame of the URDF, got ''")
@@ -61,6 +64,7 @@ class UrdfModel(PinocchioModel):
             gravity=gravity,
             viscous=arm.damping if viscous is None else viscous,
             coulomb=arm.friction if coulomb is None else coulomb,
+            coulomb_speed=coulomb_speed,
         )
 
     def __repr__(self) -> str:
@@ -107,6 +111,7 @@ class UrdfSettings:
             gravity=opts.gravity,
             viscous=_friction(opts.viscous_n_m_s_per_rad),
             coulomb=_friction(opts.coulomb_n_m),
+            coulomb_speed=_friction(opts.coulomb_speed_rad_per_s) or 0.0,
         )
 
 
@@ -144,5 +149,17 @@ class UrdfOptions:
             "N m",
             0.0,
             1e3,
+        ),
+    )
+    coulomb_speed_rad_per_s: list[float] | tuple[float, ...] = field(
+        default_factory=list,
+        metadata=param(
+            "speed over which the Coulomb friction turns, Fc tanh(q'/v_c) (m/s for a prismatic "
+            "joint), one value for every joint or one per joint; [] or 0 = Fc sgn(q'). An "
+            "observer's model (haptic-identify --urdf fits it); a simulated arm smooths by its "
+            "own physics step and refuses it",
+            "rad/s",
+            0.0,
+            10.0,
         ),
     )
