@@ -60,7 +60,7 @@ def test_set_names_one_node_or_both_sides(sections) -> None:
             teleop_params(sections, [bad])
 
 
-def test_one_process_in_lockstep_one_per_side_in_real_time_or_as_asked(sections, tmp_path) -> None:
+def test_one_process_by_default_a_process_per_side_or_per_node_as_asked(sections, tmp_path) -> None:
     params = teleop_params(sections, [])
     path = write_teleop_params(params, tmp_path)
     doc = yaml.safe_load(path.read_text())

@@ -20,8 +20,8 @@ hosts (``ROS_STATIC_PEERS``), and ``--only`` starts a subset: the device on one 
 on another (see docs/running.md, "Lab network and security").
 
 A teleoperation YAML (``/master/...`` and ``/slave/...`` sections) starts the two sides' nodes in
-their namespaces: all in one process in lockstep, a process per side in real time, by default;
-``--group`` and ``--only`` take sides there (``haptic_dob.launcher.teleop``).
+their namespaces, all in one process by default; ``--group`` and ``--only`` take sides there
+(``haptic_dob.launcher.teleop``).
 """
 
 from __future__ import annotations

@@ -1,20 +1,18 @@
 """``haptic-launch`` of a teleoperation YAML: the master's and the slave's nodes in their
-namespaces (``haptic_dob.teleop.graph``): all in one process in lockstep, a process per side in
-real time, by default.
+namespaces (``haptic_dob.teleop.graph``), all in one process by default.
 
 A YAML with ``/master/...`` or ``/slave/...`` sections is a teleoperation graph: each node's
 parameters are its sections overlaid (``node_values``), written to a params file under the
 node's full name; ``--set NS/NODE:PARAM=VALUE`` overrides one node's, ``**/NODE:`` the node of
-both sides. By default, in lockstep, all nodes share a container (every message, the channel's
-link too, handed over in process); when a device runs in real time each side's nodes share one
-(each device ticks on a CPU of its own; the link waits for nothing there, and the devices'
-``start_with`` starts their clocks together). ``--composed`` runs all nodes in one container,
-``--processes`` one process each, ``--group`` names groups (``master``, ``slave`` or ``NS/NODE``
-items). ``--only`` starts the named sides or nodes: the slave on another host, with
-``--network subnet``. ``--record BAG`` adds a ``recorder_node`` in the root namespace, in a
-process of its own: it records both sides' topics and the channel's (``recorded_topics``),
-snapshots the nodes of ``/master`` and ``/slave``, and both devices wait for it
-(``haptic-teleop --bag BAG`` analyses the bag). The options of a single loop's launch
+both sides. ``--composed`` (the default) runs all nodes in one container (every message, the
+channel's link too, handed over in process; a stall stops both sides alike), ``--processes`` one
+process each, ``--group`` names groups (``master``, ``slave`` or ``NS/NODE`` items: ``--group
+master --group slave`` gives each side a process and each device a CPU; the devices'
+``start_with`` starts their clocks together). ``--only`` starts the named sides or nodes: the
+slave on another host, with ``--network subnet``. ``--record BAG`` adds a ``recorder_node`` in
+the root namespace, in a process of its own: it records both sides' topics and the channel's
+(``recorded_topics``), snapshots the nodes of ``/master`` and ``/slave``, and both devices wait
+for it (``haptic-teleop --bag BAG`` analyses the bag). The options of a single loop's launch
 ``--namespace``, ``--pin`` and ``--cpu-latency`` are refused.
 """
 
@@ -131,23 +129,16 @@ def select_nodes(names: Sequence[str], only: Sequence[str]) -> list[str]:
 
 
 def teleop_groups(
-    names: Sequence[str],
-    composed: bool,
-    processes: bool,
-    given: Sequence[str],
-    realtime: bool = False,
+    names: Sequence[str], composed: bool, processes: bool, given: Sequence[str]
 ) -> list[list[str]]:
-    """Which nodes share a process: ``--composed`` all, ``--processes`` none, ``--group``
-    (``master``, ``slave`` or ``NS/NODE`` items) the named ones; by default all in lockstep (the
-    channel's link handed over in process), each side's in real time (each device on a CPU)."""
+    """Which nodes share a process: ``--processes`` none, ``--group`` (``master``, ``slave`` or
+    ``NS/NODE`` items) the named ones, else (``--composed``, the default) all."""
     if sum((composed, processes, bool(given))) > 1:
         raise CliError("--composed, --processes and --group are different choices: pick one")
     if processes:
         return []
-    if composed or (not given and not realtime):
-        return [list(names)]
     if not given:
-        return [g for g in ([n for n in names if n.startswith(f"{ns}/")] for ns in NAMESPACES) if g]
+        return [list(names)]
     groups: list[list[str]] = []
     seen: set[str] = set()
     for text in given:
@@ -202,8 +193,7 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
         )
     params = teleop_params(sections, opts.sets)
     names = select_nodes([n for n in params if "/" in n], opts.only)
-    realtime = any(params[f"{ns}/device_node"].get("clock_mode") == "realtime" for ns in NAMESPACES)
-    groups = teleop_groups(names, opts.composed, opts.processes, opts.groups, realtime)
+    groups = teleop_groups(names, opts.composed, opts.processes, opts.groups)
     if opts.record and opts.only:
         raise CliError(
             "--record with --only: both sides' devices wait for the recorder, so record where "
