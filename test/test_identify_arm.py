@@ -89,6 +89,19 @@ def test_the_friction_beyond_the_urdf_is_found_and_explains_held_out_data(record
 
 
 @pytest.mark.slow
+def test_the_turn_searched_through_the_fits_own_low_pass_is_the_default(record) -> None:
+    """``turn_cutoff_hz`` equal to ``cutoff_hz`` takes the search's second set of filters (built
+    and applied apart) and must give the default fit exactly; a wider one changes the turn."""
+    rigid = UrdfModel(ARM3, "tool")
+    args = (rigid, record.stamps_ns, record.position, record.effort, record.names)
+    plain = identify_arm_friction(*args)
+    same = identify_arm_friction(*args, turn_cutoff_hz=20.0)
+    assert same == plain
+    wide = identify_arm_friction(*args, turn_cutoff_hz=50.0)
+    assert [j.coulomb_speed for j in wide.joints] != [j.coulomb_speed for j in plain.joints]
+
+
+@pytest.mark.slow
 def test_a_continuous_joint_wrapped_by_its_driver_gives_the_same_friction(record) -> None:
     """arm3's base yaw (joint1) turned by 2.8 rad and wrapped to (-pi, pi], as a driver reports
     a continuous joint: the yaw does not enter the dynamics, so the fit must not change beyond
@@ -144,6 +157,9 @@ def test_cli_reads_the_arms_bag_and_writes_the_friction_the_observer_loads(
         (["--urdf", str(ARM3), "--tip-frame", "nope"], "tip_frame 'nope' is not a frame"),
         (["--urdf", str(ARM3), "--tip-frame", "tool", "--joints", "joint1,elbow"], "elbow"),
         (["--urdf", str(ARM3), "--tip-frame", "tool"], "too short: 50 samples"),
+        (["--turn-cutoff-hz", "50"], "--turn-cutoff-hz needs --urdf"),
+        (["--urdf", str(ARM3), "--tip-frame", "tool", "--turn-cutoff-hz", "0"], "positive"),
+        (["--urdf", str(ARM3), "--tip-frame", "tool", "--turn-cutoff-hz", "nan"], "positive"),
     ],
 )
 def test_bad_arm_arguments_and_records_get_one_line_and_exit_2(tmp_path, args, message) -> None:

@@ -93,21 +93,21 @@ def test_moving_freely_the_estimate_stays_small_with_the_identified_friction(con
     """The slave's joints have friction its URDF lacks; the observer's model carries the friction
     identified from its joint states (the YAML's values, ``test_the_identification_...``), its
     Coulomb part turning over the identified speeds. Moving across the workspace the estimate's
-    RMS stays under 0.1 N (measured 0.058 N; 0.175 N with Coulomb as a sign); it exceeds 0.2 N
-    on under 3 % of the samples (1.7 %), each near a joint's velocity reversal, where the joint
-    sticks for a moment and its friction is anywhere within +-Fc, and never 1 N (0.67 N). With
-    the URDF alone it is over 1 N."""
+    RMS stays under 0.05 N (measured 0.033 N; 0.175 N with Coulomb as a sign); it exceeds 0.2 N
+    on under 1.5 % of the samples (0.74 %), each near a joint's velocity reversal, where the
+    joint sticks for a moment and its friction is anywhere within +-Fc, and never 0.5 N
+    (0.36 N). With the URDF alone it is over 1 N."""
     identified = free_sweep(free_config(config, {}))
     raw = free_sweep(free_config(config, {k: [0.0] for k in FRICTION}))
     settle = 500  # the observer's start and the ramp
     e = np.linalg.norm(identified.estimate, axis=1)[settle:]
     e_raw = np.linalg.norm(raw.estimate, axis=1)[settle:]
     assert np.max(np.linalg.norm(identified.contact, axis=1)) == 0.0
-    assert np.sqrt(np.mean(e * e)) < 0.1
-    assert np.max(e) < 1.0
+    assert np.sqrt(np.mean(e * e)) < 0.05
+    assert np.max(e) < 0.5
     assert np.sqrt(np.mean(e_raw * e_raw)) > 1.0
     over = e > 0.2
-    assert np.mean(over) < 0.03
+    assert np.mean(over) < 0.015
     assert np.all(reversals(identified.qd[settle:], 60)[over])  # only near a reversal
 
 
@@ -129,14 +129,14 @@ def test_the_identification_finds_the_slave_friction_the_yaml_carries(config) ->
     for key in FRICTION:
         found = np.array(fit[key])
         np.testing.assert_allclose(found, carried[key], atol=0.01)  # the YAML's are these
-        np.testing.assert_allclose(found, truth[key], rtol=0.06)  # the plant's own (<= 5.2 %)
+        np.testing.assert_allclose(found, truth[key], rtol=0.06)  # the plant's own (<= 5.1 %)
     speed = np.array(fit[SPEED])
     np.testing.assert_allclose(speed, carried[SPEED], rtol=0.02)  # the YAML's
     eps = cfg.slave_device()._coulomb_eps  # the simulator's own
     np.testing.assert_allclose(speed[4:], eps[4:], rtol=0.1)  # the wrist: measured <= 4 %
     # the heavy joints' 1 mrad/s is the encoders' resolution (1 urad a sample) over a few
-    # samples: found 1.0-2.2 mrad/s
-    assert np.all((speed[:4] >= 0.5 * eps[:4]) & (speed[:4] <= 2.5 * eps[:4])), speed
+    # samples: found 1.0-2.0 mrad/s (1.0-2.2 with the search at the fit's 20 Hz low-pass)
+    assert np.all((speed[:4] >= 0.5 * eps[:4]) & (speed[:4] <= 2.1 * eps[:4])), speed
     for j in result.joints:
         assert j.heldout_rms < 0.05 * j.heldout_rms_rigid, j  # measured 0.2-1.6 %
 

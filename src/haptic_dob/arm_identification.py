@@ -7,7 +7,11 @@ per joint as viscous plus Coulomb friction by least squares, with the filters th
 identification uses (``haptic_dob.fit_filters``). The speed ``v_c`` over which the Coulomb
 friction turns is found by a search over a grid (least squares for ``b`` and ``Fc`` at each
 value, the smallest residual wins), on every sample but the filters' ends, slow ones included:
-they are where it shows (a sign model errs by up to ``2 Fc`` there, at every reversal).
+they are where it shows (a sign model errs by up to ``2 Fc`` there, at every reversal). A turn
+lasts a few milliseconds, which the fit's low-pass (``cutoff_hz``, for the accelerations' noise)
+smears over tens: where the encoders resolve speeds well below the turn's, the search may judge
+each candidate through a wider low-pass (``turn_cutoff_hz``), ``b`` and ``Fc`` still fitted
+through the usual one.
 
 The fit uses the first ``1 - holdout`` of the record; the rest is held out: each joint reports
 the RMS of what the rigid-body model leaves unexplained there without friction and with the
@@ -74,12 +78,14 @@ def identify_arm_friction(
     cutoff_hz: float = 20.0,
     min_speed: float = 0.02,
     holdout: float = 0.3,
+    turn_cutoff_hz: float | None = None,
 ) -> ArmFrictionFit:
     """Fit each joint's viscous and Coulomb friction on the effort ``rigid`` leaves unexplained.
 
     ``position`` and ``effort`` are (N, dof) in ``rigid``'s joint order (``names``); the effort of
     sample k was applied over [k-1, k). ``min_speed`` (rad/s or m/s): the held-out residuals, and
-    the check that each joint moved enough, count only faster samples.
+    the check that each joint moved enough, count only faster samples. ``turn_cutoff_hz``: the
+    low-pass through which the search for ``v_c`` judges each candidate (default ``cutoff_hz``).
     """
     n, dof = position.shape
     if dof != rigid.dof or effort.shape != position.shape:
@@ -93,19 +99,15 @@ def identify_arm_friction(
     if not dt > 0.0 or not np.all(np.isfinite(position)) or not np.all(np.isfinite(effort)):
         raise IdentificationError("the stamps do not increase, or a value is not finite")
     f = MotionFilters.design(dt, cutoff_hz)
+    wide = f if turn_cutoff_hz is None else MotionFilters.design(dt, turn_cutoff_hz)
     # continuous joints a driver wraps to (-pi, pi]; no other joint jumps by pi in one sample
     position = np.unwrap(position, axis=0)
-    x, v, a = f.motion(position)
-    rigid_effort = np.array([rigid.inverse_dynamics(x[k], v[k], a[k]) for k in range(n)])
-    r = f.effort(effort) - rigid_effort  # what friction (and anything not modelled) explains
     v_light = f.light_velocity(position)
+    r, v = _unexplained(rigid, f, position, effort)
+    r_w, v_w = (r, v) if wide is f else _unexplained(rigid, wide, position, effort)
     split = int((1.0 - holdout) * n)
-    edge = 2 * f.window
-    every = np.arange(edge, split, f.step)  # slow samples too: the turn of Coulomb shows there
-    terms = [
-        f.coulomb_term(v_light) if c == 0.0 else f.smooth(np.tanh(v_light / c))
-        for c in COULOMB_SPEEDS
-    ]
+    every = np.arange(2 * f.window, split, f.step)  # slow samples too: the turn shows there
+    every_w = np.arange(2 * wide.window, split, wide.step)
     out = []
     for j, name in enumerate(names):
         usable = f.usable(v_light[:, j], min_speed)
@@ -116,16 +118,18 @@ def identify_arm_friction(
                 f"{name}: too little motion to fit ({len(moving) // f.step} usable samples faster "
                 f"than {min_speed:g}/s before the held-out part, {len(test_idx)} in it)"
             )
-        best = None
-        for c, s in zip(COULOMB_SPEEDS, terms, strict=True):
-            X = np.column_stack([v[every, j], s[every, j]])
-            theta, std, rms = fit(X, r[every, j], str(name))
-            if best is None or rms < best[3]:
-                best = (c, theta, std, rms, s)
-        assert best is not None
-        c, theta, std, _, s = best
+        c = _turn_speed(
+            f,
+            wide,
+            v_light[:, j],
+            (v[:, j], r[:, j], every),
+            (v_w[:, j], r_w[:, j], every_w),
+            str(name),
+        )
+        s = _coulomb(f, v_light[:, j], c)
+        theta, std, _ = fit(np.column_stack([v[every, j], s[every]]), r[every, j], str(name))
         rt = r[test_idx, j]
-        pred = np.column_stack([v[test_idx, j], s[test_idx, j]]) @ theta
+        pred = np.column_stack([v[test_idx, j], s[test_idx]]) @ theta
         out.append(
             JointFriction(
                 str(name),
@@ -140,3 +144,39 @@ def identify_arm_friction(
             )
         )
     return ArmFrictionFit(out, holdout)
+
+
+def _unexplained(
+    rigid: PinocchioModel, f: MotionFilters, position: Arr, effort: Arr
+) -> tuple[Arr, Arr]:
+    """The effort the rigid body leaves unexplained and the velocity, both through ``f``."""
+    x, v, a = f.motion(position)
+    rigid_effort = np.array([rigid.inverse_dynamics(x[k], v[k], a[k]) for k in range(len(x))])
+    return f.effort(effort) - rigid_effort, v
+
+
+def _coulomb(f: MotionFilters, v_light: Arr, speed: float) -> Arr:
+    """The Coulomb term through ``f``: the sign (``speed`` 0) or ``tanh(v / speed)``."""
+    return f.coulomb_term(v_light) if speed == 0.0 else f.smooth(np.tanh(v_light / speed))
+
+
+def _turn_speed(
+    f: MotionFilters,
+    wide: MotionFilters,
+    v_light: Arr,
+    terms: tuple[Arr, Arr, NDArray[np.intp]],
+    terms_w: tuple[Arr, Arr, NDArray[np.intp]],
+    where: str,
+) -> float:
+    """The grid's ``v_c`` whose model (``b`` and ``Fc`` by least squares through ``f``) leaves
+    the least residual through ``wide``; ``terms``: (velocity, unexplained effort, samples)."""
+    v, r, every = terms
+    v_w, r_w, every_w = terms_w
+    best = (math.inf, 0.0)
+    for c in COULOMB_SPEEDS:
+        s = _coulomb(f, v_light, c)
+        theta, _, _ = fit(np.column_stack([v[every], s[every]]), r[every], where)
+        s_w = s if wide is f else _coulomb(wide, v_light, c)
+        e = r_w[every_w] - np.column_stack([v_w[every_w], s_w[every_w]]) @ theta
+        best = min(best, (float(e @ e), c))
+    return best[1]

@@ -33,6 +33,7 @@ class ArmSpec:
     urdf: str
     tip_frame: str
     joints: tuple[str, ...] = ()
+    turn_cutoff_hz: float | None = None  # the search for v_c through this low-pass (Hz)
 
 
 #: why a fit has no Coulomb friction: the step method separates it from the swings' decay only
@@ -98,7 +99,14 @@ def arm_command(bag: str, topic: str, arm: ArmSpec, as_json: bool, write_yaml: s
     rigid = UrdfModel(arm.urdf, arm.tip_frame, arm.joints or None, viscous=0.0, coulomb=0.0)
     js = read_joints(bag, topic, rigid.joint_names)
     try:
-        fit = identify_arm_friction(rigid, js.stamps_ns, js.position, js.effort, js.names)
+        fit = identify_arm_friction(
+            rigid,
+            js.stamps_ns,
+            js.position,
+            js.effort,
+            js.names,
+            turn_cutoff_hz=arm.turn_cutoff_hz,
+        )
     except IdentificationError as exc:
         raise CliError(f"{bag}: {exc}") from None
     if as_json:
@@ -166,13 +174,25 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="with --urdf: comma-separated joints (default: the chain to the tip); the chain's "
         "other joints are taken as still at zero",
     )
+    p.add_argument(
+        "--turn-cutoff-hz",
+        type=float,
+        metavar="HZ",
+        help="with --urdf: judge the speed the Coulomb friction turns over through this "
+        "low-pass (default: the fit's 20 Hz); a wider one (e.g. 50) resolves a turn of a few "
+        "milliseconds where the encoders resolve speeds well below it",
+    )
     a = p.parse_args(argv)
+    if a.turn_cutoff_hz is not None and not 0.0 < a.turn_cutoff_hz < float("inf"):
+        p.error(f"--turn-cutoff-hz must be a positive number of Hz, got {a.turn_cutoff_hz:g}")
     if a.urdf:
         if not a.tip_frame:
             p.error("--urdf needs --tip-frame")
         joints = tuple(j for j in (a.joints or "").split(",") if j)
-        arm = ArmSpec(a.urdf, a.tip_frame, joints)
+        arm = ArmSpec(a.urdf, a.tip_frame, joints, a.turn_cutoff_hz)
         return run(lambda: arm_command(a.bag, a.topic, arm, a.json, a.write_yaml))
+    if a.turn_cutoff_hz is not None:
+        p.error("--turn-cutoff-hz needs --urdf")
     return run(lambda: command(a.bag, a.topic, a.joint, a.method, a.json, a.write_yaml))
 
 

@@ -132,14 +132,26 @@ def excitation(
     return at
 
 
+#: the low-pass (Hz) through which the slave's turn speeds are searched: its encoders resolve
+#: 1 urad a sample, speeds far below the 1-2 mrad/s its heavy joints' friction turns over
+SLAVE_TURN_CUTOFF_HZ = 50.0
+
+
 def identify_slave_friction(
     config: TeleopConfig, run: SlaveRun, holdout: float = 0.3
 ) -> ArmFrictionFit:
     """Each joint's viscous and Coulomb friction from a slave run's joint states (the effort
-    beyond the rigid body of the slave's URDF), as ``haptic-identify --urdf`` fits a bag."""
+    beyond the rigid body of the slave's URDF), as ``haptic-identify --urdf --turn-cutoff-hz
+    50`` fits a bag."""
     rigid = _rigid_body(config)
     return identify_arm_friction(
-        rigid, run.stamps_ns, run.q, run.effort, list(rigid.joint_names), holdout=holdout
+        rigid,
+        run.stamps_ns,
+        run.q,
+        run.effort,
+        list(rigid.joint_names),
+        holdout=holdout,
+        turn_cutoff_hz=SLAVE_TURN_CUTOFF_HZ,
     )
 
 
