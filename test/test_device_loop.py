@@ -294,9 +294,14 @@ def test_realtime_ticks_apply_the_newest_command_and_the_watchdog_zeroes_a_silen
         loop.tick(t)
         t += 0.001
         assert port.sent[-1].effort == (1.5,) and not loop.watchdog.tripped
+    sent_at_trip: list[int] = []  # samples out when the trip is said: after the tick's own
+    warning = log.warning
+    log.warning = lambda m, **kw: (sent_at_trip.append(len(port.sent)), warning(m, **kw))  # type: ignore[method-assign]
+    before = len(port.sent)
     loop.tick(t)
     assert port.sent[-1].effort == (0.0,) and loop.watchdog.tripped
     assert log.said("watchdog: no valid effort_command for 6 samples (limit 5 ms") == 1
+    assert sent_at_trip == [before + 1]
     command(loop, -1.0, stamped=False)
     loop.tick(t + 0.001)
     assert port.sent[-1].effort == (-1.0,) and not loop.watchdog.tripped

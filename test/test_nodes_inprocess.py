@@ -13,7 +13,7 @@ from haptic_dob.nodes.controller_node import ControllerNode
 from haptic_dob.nodes.environment_node import EnvironmentNode
 from haptic_dob.nodes.observer_node import ObserverNode
 from haptic_dob.nodes.slave_controller_node import SlaveControllerNode
-from haptic_msgs_py.values import EffortCommand, StampedVector
+from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
 from haptic_sim.nodes.device_node import DeviceNode
 from rosgraph import isolated_env
 from waits import wait_until
@@ -137,6 +137,37 @@ def test_observer_retunes_without_a_jump_and_refuses_a_bad_gain(context) -> None
         assert not res.successful and obs.observer.gain == 10.0
         assert obs.set_parameters([Parameter("output_limit", value=0.0)])[0].successful
         assert obs.observer.limit is None
+    finally:
+        obs.destroy_node()
+
+
+def test_the_observer_answers_a_gap_and_says_so_after_it_once_per_throttle(context, capfd) -> None:
+    """Samples 0, 1, 3, 4, 7: every one answered with an estimate; the two gaps counted, the
+    first said after its estimate went out, the second (within the 5 s throttle) not said."""
+    obs = ObserverNode(context=context)
+    events: list[tuple[str, int]] = []
+    publish, warning = obs._publish, obs.log.warning
+
+    def sent(stamp_ns: int) -> None:
+        events.append(("estimate", stamp_ns))
+        publish(stamp_ns)
+
+    def said(message: str, **kwargs: float) -> bool:
+        events.append(("said", obs._last_ns))
+        return warning(message, **kwargs)
+
+    obs._publish = sent  # type: ignore[method-assign]
+    obs.log.warning = said  # type: ignore[method-assign]
+    try:
+        capfd.readouterr()
+        stamps = [k * obs.period_ns for k in (0, 1, 3, 4, 7)]
+        for k, stamp in enumerate(stamps):
+            obs._on_joint_states(JointSample(stamp, obs._names, (0.001 * k,), (0.0,), (0.1,)))
+        assert [s for e, s in events if e == "estimate"] == stamps and obs.gaps == 2
+        assert events.index(("estimate", stamps[2])) < events.index(("said", stamps[2]))
+        err = capfd.readouterr().err
+        assert err.count("joint_states jumped") == 1, err
+        assert "joint_states jumped 2 periods (1 gaps so far)" in err, err
     finally:
         obs.destroy_node()
 

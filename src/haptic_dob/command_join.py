@@ -76,8 +76,8 @@ class CommandJoin:
         needs_q: bool,
         input_timeout_ns: float = 20_000_000,
         fallback: str = "zero",
-        warn: Callable[[str], None] = _quiet,
-        info: Callable[[str], None] = _quiet,
+        warn: Callable[[str], object] = _quiet,
+        info: Callable[[str], object] = _quiet,
     ) -> None:
         if fallback not in FALLBACKS:
             raise ValueError(f"fallback must be one of {', '.join(FALLBACKS)}, got {fallback!r}")

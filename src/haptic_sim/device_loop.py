@@ -94,6 +94,7 @@ class DeviceLoop:
         self.guard = CommandGuard(device.max_effort, self._say_refusing)
         self.configure(self.settings_for(values))
         self.watchdog = CommandWatchdog(self.period_ns, self._say_tripped, self._say_resumed)
+        self._tripped_line = ""  # what the watchdog has to say, once the sample is out
         self.realtime = RealtimeStats()
         self.recorders = RecorderGate()
         self.zero = [0.0] * device.dof
@@ -123,12 +124,17 @@ class DeviceLoop:
         )
 
     def _say_tripped(self, held: str) -> None:
+        """Said once the tick's sample is out (``tick``)."""
         timeout = self.settings.command_timeout_s
-        self.log.warning(
+        self._tripped_line = (
             f"watchdog: no valid {EFFORT_COMMAND} for {held} (limit {timeout * 1e3:g} ms of "
-            f"simulated time): effort zeroed ({self.watchdog.trips} trips so far)",
-            throttle_duration_sec=1.0,
+            f"simulated time): effort zeroed ({self.watchdog.trips} trips so far)"
         )
+
+    def _say_pending(self) -> None:
+        if self._tripped_line:
+            self.log.warning(self._tripped_line, throttle_duration_sec=1.0)
+            self._tripped_line = ""
 
     def _say_resumed(self) -> None:
         self.log.info("valid effort_command again: effort resumed", throttle_duration_sec=1.0)
@@ -319,6 +325,7 @@ class DeviceLoop:
             effort = self.zero
         self.advance(effort)
         self.send_sample()
+        self._say_pending()
         self.deadline = self.realtime.next_deadline(self.deadline, now, period)
 
     # --- end ------------------------------------------------------------------------------

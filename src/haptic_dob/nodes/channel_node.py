@@ -116,7 +116,7 @@ class ChannelNode(LoopNode):
         self.wait = bool(v["wait_for_peer"])
         master = self.role == "master"
         peer = "slave" if master else "master"
-        log = self.get_logger()
+        log = self.log
 
         def lost(why: str) -> None:
             log.warning(f"nothing from the {peer} for {why}: {self._fallback()}")

@@ -108,7 +108,7 @@ class ControllerNode(LoopNode):
         values = self.params.values
         self.model = build_model(values)
         self.period_ns = period_ns(values["rate_hz"])
-        log = self.get_logger()
+        log = self.log
         self.join = CommandJoin(
             ImpedanceController(self.model, self.params.settings),
             self.period_ns,
@@ -161,7 +161,7 @@ class ControllerNode(LoopNode):
         self.join.input_timeout_ns = values["input_timeout_s"] * 1e9
         self.join.fallback = values["fallback"]
         self.join.set_law(law)
-        self.get_logger().info(
+        self.log.info(
             f"law now {law.mode.value}, Kf {law.kf:g}, max {law.max_force_n:g} N, from the cycle "
             f"after stamp_ns {self.join.sent_ns}"
         )
@@ -172,7 +172,7 @@ class ControllerNode(LoopNode):
             idx = self.joints.index(js.name, len(js.position))
             q = pick(js.position, idx, "position", len(js.name) or len(js.position))
         except ValueError as exc:
-            self.get_logger().error(f"ignoring joint_states: {exc}", throttle_duration_sec=5.0)
+            self.log.error(f"ignoring joint_states: {exc}", throttle_duration_sec=5.0)
             return
         self._opened(js.stamp_ns)
         self._send(self.join.joints(js.stamp_ns, q))
@@ -214,7 +214,7 @@ class ControllerNode(LoopNode):
     def on_wakeup(self, now: float) -> None:
         """Name the inputs a pending cycle still lacks (once per cycle)."""
         self._warned_ns = self.join.newest_ns
-        self.get_logger().warning(
+        self.log.warning(
             f"cycle at stamp {self.join.newest_ns * 1e-9:.3f} s still lacks "
             f"{', '.join(self.join.missing_inputs())} after {now - self._pending_since:.1f} s"
         )

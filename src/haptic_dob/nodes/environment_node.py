@@ -98,7 +98,7 @@ class EnvironmentNode(LoopNode):
     def _apply(self, env: Environment) -> None:
         self.wall, self.excitation = env
         self._adds = env.excitation if env.excitation.active else None
-        self.get_logger().info(f"wall now {env.wall}, excitation {env.excitation.label()}")
+        self.log.info(f"wall now {env.wall}, excitation {env.excitation.label()}")
 
     def _on_pose(self, pose: StampedVector) -> None:
         self._pose = pose

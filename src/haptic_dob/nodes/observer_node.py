@@ -112,7 +112,7 @@ class ObserverNode(LoopNode):
     def _apply(self, settings: ObserverSettings) -> None:
         """A new gain or limit, taken on the next sample without a jump of the estimate."""
         self.observer.retune(settings.gain, settings.output_limit or None)
-        self.get_logger().info(f"observer now {settings}")
+        self.log.info(f"observer now {settings}")
 
     def _on_reset(self, _req: Trigger.Request, res: Trigger.Response) -> Trigger.Response:
         self.observer.reset()
@@ -136,19 +136,20 @@ class ObserverNode(LoopNode):
         except ValueError as exc:
             self._complain(str(exc))
             return
-        if self._last_ns >= 0 and now - self._last_ns != self.period_ns:
-            self.gaps += 1
-            self.get_logger().warning(
-                f"joint_states jumped {(now - self._last_ns) / self.period_ns:g} periods "
-                f"({self.gaps} gaps so far); the update assumes one",
-                throttle_duration_sec=5.0,
-            )
+        jump = (now - self._last_ns) / self.period_ns if self._last_ns >= 0 else 1.0
         self._prev_q = q
         self._last_ns = now
         self._bad_input_logged = ""
         self._force = estimate(self.observer, q, qd, tau)
+        self._publish(now)  # the estimate first, then what is said of it
         self.diagnostics.tick()
-        self._publish(now)
+        if jump != 1.0:
+            self.gaps += 1
+            self.log.warning(
+                f"joint_states jumped {jump:g} periods ({self.gaps} gaps so far); the update "
+                "assumes one",
+                throttle_duration_sec=5.0,
+            )
 
     def _publish(self, stamp_ns: int) -> None:
         """The estimate of sample ``stamp_ns``: the wrench first (the controller may wait for
@@ -160,7 +161,7 @@ class ObserverNode(LoopNode):
 
     def _complain(self, reason: str) -> None:
         if reason != self._bad_input_logged:  # once per distinct problem, not at 1 kHz
-            self.get_logger().error(f"ignoring joint_states: {reason}")
+            self.log.error(f"ignoring joint_states: {reason}")
             self._bad_input_logged = reason
 
 

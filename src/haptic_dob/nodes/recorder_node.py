@@ -115,7 +115,7 @@ class RecorderNode(LoopNode):
             self.create_publisher(Header, progress_topic(n), PROGRESS_QOS) for n in v["namespaces"]
         ]
         self.create_timer(1.0 / v["progress_rate_hz"], self._publish_progress)
-        self.get_logger().info(
+        self.log.info(
             f"recording {len(topics)} topic(s) to {self.recording.path} ({self.recording.storage})"
         )
 
@@ -165,7 +165,7 @@ class RecorderNode(LoopNode):
         self._step_snapshots()
         timeout = self.snapshots.timeout_s
         for snap in self.snapshots.overdue(now):
-            self.get_logger().warning(
+            self.log.warning(
                 f"no parameters from {snap.node} within {timeout:g} s yet; still asking "
                 "(until then the bag does not know them)"
             )
@@ -225,16 +225,14 @@ class RecorderNode(LoopNode):
             self._finish_snapshots()
             take_until_quiet(self._take_round, self.params.values["drain_timeout_s"])
         except Exception as exc:  # the context may already be gone
-            self.get_logger().warning(f"could not drain the queues: {exc}")
+            self.log.warning(f"could not drain the queues: {exc}")
         for snap in self.snapshots.pending:
-            self.get_logger().warning(
-                f"closing without the parameters of {snap.node}: it never answered"
-            )
+            self.log.warning(f"closing without the parameters of {snap.node}: it never answered")
         self.recording.close()
 
     def on_shutdown(self) -> None:
         self.close()
-        log = self.get_logger()
+        log = self.log
         for c in self.recording.counts.topics:
             log.info(c.log_line())
         snapshots = self.recording.counts.snapshots

@@ -75,7 +75,7 @@ class SlaveControllerNode(LoopNode):
             q = pick(js.position, idx, "position", n)
             qd = pick(js.velocity, idx, "velocity", n)
         except ValueError as exc:
-            self.get_logger().error(f"ignoring joint_states: {exc}", throttle_duration_sec=5.0)
+            self.log.error(f"ignoring joint_states: {exc}", throttle_duration_sec=5.0)
             return
         self._q = (js.stamp_ns, q, qd)
         self._step()

@@ -87,7 +87,7 @@ class DeviceNode(LoopNode):
         self.lockstep = v["clock_mode"] == "lockstep"
         cycles = round(v["duration_s"] * v["rate_hz"])
         last_k = cycles if cycles > 0 else None  # the run ends after publishing sample N
-        self.loop = DeviceLoop(self.device, self, self.get_logger(), v, self.lockstep, last_k)
+        self.loop = DeviceLoop(self.device, self, self.log, v, self.lockstep, last_k)
         self.finishes_run = last_k is not None  # a process of two devices waits for both
         self.params.set_validator(self.loop.settings_for, self._apply)
         base = v["base_frame"]
@@ -113,7 +113,7 @@ class DeviceNode(LoopNode):
         )
         self.diagnostics = Diagnostics(self, self._report)
         mode = "lockstep" if self.lockstep else f"realtime at {v['rate_hz']:g} Hz"
-        self.get_logger().info(
+        self.log.info(
             f"simulated {v['model']} device, {mode}, effort limits {list(self.limits)}, "
             f"scheduling {scheduling()}"
         )
@@ -125,7 +125,7 @@ class DeviceNode(LoopNode):
 
     def _apply(self, settings: DeviceLoopSettings) -> None:
         self.loop.configure(settings)
-        self.get_logger().info(f"effort limits now {list(self.limits)}")
+        self.log.info(f"effort limits now {list(self.limits)}")
 
     def _advance(self, effort: list[float]) -> None:
         """Command k moves the plant (``DeviceLoop.advance``)."""
@@ -239,7 +239,7 @@ class DeviceNode(LoopNode):
             with open(path, "w", encoding="utf-8") as fh:
                 json.dump(asdict(self.stats()), fh, indent=2)
         self.loop.shutdown()
-        self.get_logger().info("shutdown: effort zeroed")
+        self.log.info("shutdown: effort zeroed")
 
 
 def scheduling() -> str:
