@@ -17,6 +17,7 @@ import pytest
 from conftest import tool
 from haptic_dob.arm_identification import identify_arm_friction
 from haptic_dob.bag.joints import JointStates, read_joints
+from haptic_dob.fit_filters import IdentificationError
 from haptic_dob.models import UrdfModel
 from haptic_dob.models.factory import build_model
 from haptic_dob.runtime.params import load_node_params
@@ -99,6 +100,10 @@ def test_the_turn_searched_through_the_fits_own_low_pass_is_the_default(record) 
     assert same == plain
     wide = identify_arm_friction(*args, turn_cutoff_hz=50.0)
     assert [j.coulomb_speed for j in wide.joints] != [j.coulomb_speed for j in plain.joints]
+    with pytest.raises(IdentificationError, match=r"turn_cutoff_hz must be at least .*20 Hz"):
+        identify_arm_friction(*args, turn_cutoff_hz=5.0)  # narrower than the fit's
+    with pytest.raises(IdentificationError, match=r"turn_cutoff_hz: cutoff must be in \(0, 250\)"):
+        identify_arm_friction(*args, turn_cutoff_hz=300.0)
 
 
 @pytest.mark.slow

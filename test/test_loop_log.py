@@ -15,8 +15,9 @@ import textwrap
 FORMAT = "[{severity}] [{name}] {function_name} {file_name}:{line_number}: {message}"
 
 
-def run(body: str, *, level: str = "") -> list[str]:
-    """Run ``body`` (``log``: a LoopLog, ``ros``: its rclpy logger) and return its stderr lines."""
+def run(body: str, *, level: str = "", stdout: str | None = None) -> list[str]:
+    """Run ``body`` (``log``: a LoopLog, ``ros``: its rclpy logger) and return its stderr lines;
+    ``stdout``: what it must print."""
     script = textwrap.dedent(
         """
         import time
@@ -36,6 +37,8 @@ def run(body: str, *, level: str = "") -> list[str]:
         [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=60
     )
     assert out.returncode == 0, out.stderr
+    if stdout is not None:
+        assert out.stdout == stdout, out.stdout
     return out.stderr.splitlines()
 
 
@@ -56,6 +59,24 @@ def test_a_line_is_the_line_rclpy_says_from_the_same_call_site() -> None:
     assert lines[0].endswith("<string>:9: the watchdog tripped"), lines
 
 
+def test_a_method_handed_over_as_a_callback_names_the_code_that_calls_it() -> None:
+    """``warn=log.warning`` given to a core object (the controller's command join): the line
+    names the core's function and line, as rclpy's own bound method does."""
+    lines = run(
+        """
+        class Join:
+            def __init__(self, warn):
+                self.warn = warn
+            def fall_back(self):
+                self.warn("input late: fallback")
+        Join(ros.warning).fall_back()
+        Join(log.warning).fall_back()
+        """
+    )
+    assert len(lines) == 2 and lines[0] == lines[1], lines
+    assert " fall_back " in lines[0] and "<string>:" in lines[0], lines
+
+
 def test_each_severity_is_said_as_rclpy_names_it() -> None:
     lines = run(
         """
@@ -74,6 +95,7 @@ def test_a_logger_level_silences_what_is_below_it() -> None:
         print(log.info("below"), log.error("above"), flush=True)
         """,
         level="ERROR",
+        stdout="False True\n",
     )
     assert lines == [lines[0]] and lines[0].endswith(": above"), lines
 

@@ -99,7 +99,7 @@ def identify_arm_friction(
     if not dt > 0.0 or not np.all(np.isfinite(position)) or not np.all(np.isfinite(effort)):
         raise IdentificationError("the stamps do not increase, or a value is not finite")
     f = MotionFilters.design(dt, cutoff_hz)
-    wide = f if turn_cutoff_hz is None else MotionFilters.design(dt, turn_cutoff_hz)
+    wide = f if turn_cutoff_hz is None else _turn_filters(dt, cutoff_hz, turn_cutoff_hz)
     # continuous joints a driver wraps to (-pi, pi]; no other joint jumps by pi in one sample
     position = np.unwrap(position, axis=0)
     v_light = f.light_velocity(position)
@@ -153,6 +153,20 @@ def _unexplained(
     x, v, a = f.motion(position)
     rigid_effort = np.array([rigid.inverse_dynamics(x[k], v[k], a[k]) for k in range(len(x))])
     return f.effort(effort) - rigid_effort, v
+
+
+def _turn_filters(dt: float, cutoff_hz: float, turn_cutoff_hz: float) -> MotionFilters:
+    """The search's filters: a low-pass no narrower than the fit's; ``IdentificationError``
+    naming ``turn_cutoff_hz`` otherwise."""
+    if not turn_cutoff_hz >= cutoff_hz:
+        raise IdentificationError(
+            f"turn_cutoff_hz must be at least the fit's cutoff ({cutoff_hz:g} Hz), got "
+            f"{turn_cutoff_hz:g}"
+        )
+    try:
+        return MotionFilters.design(dt, turn_cutoff_hz)
+    except IdentificationError as exc:
+        raise IdentificationError(f"turn_cutoff_hz: {exc}") from None
 
 
 def _coulomb(f: MotionFilters, v_light: Arr, speed: float) -> Arr:

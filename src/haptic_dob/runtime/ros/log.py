@@ -18,15 +18,12 @@ import sys
 import time
 from typing import Any
 
+from rclpy.impl.implementation_singleton import rclpy_implementation as _impl
 from rclpy.impl.logging_severity import LoggingSeverity
 from rclpy.impl.rcutils_logger import RcutilsLogger
 
-try:  # rcutils' log call, which RcutilsLogger.log ends with
-    from rclpy.impl.implementation_singleton import rclpy_implementation as _impl
-
-    _emit = _impl.rclpy_logging_rcutils_log
-except (ImportError, AttributeError):  # pragma: no cover - another rclpy: its own path
-    _emit = None
+#: rcutils' log call, which ``RcutilsLogger.log`` ends with
+_emit = _impl.rclpy_logging_rcutils_log
 
 
 class LoopLog:
@@ -34,8 +31,9 @@ class LoopLog:
     (``throttle_duration_sec`` the one filter), cheap enough for a 1 kHz callback.
 
     A throttled call site (its code and bytecode offset, as rclpy keys it) says at most one line
-    every ``throttle_duration_sec`` of the steady clock, the first at once; each call says
-    whether it was said.
+    every ``throttle_duration_sec``, the first at once; each call says whether it was said. The
+    period runs on the monotonic clock (rclpy's filter reads the system clock, which a time
+    adjustment moves).
     """
 
     def __init__(self, logger: RcutilsLogger) -> None:
@@ -75,8 +73,6 @@ class LoopLog:
             if now < self._next.get(site, -math.inf):
                 return False
             self._next[site] = now + every
-        if _emit is None:  # pragma: no cover - another rclpy
-            return bool(self.logger.log(message, severity))
         code = caller.f_code
         path = self._files.get(code)
         if path is None:
