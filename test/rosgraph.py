@@ -20,7 +20,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from waits import wait_until
+from waits import RESEND_S, wait_until
 
 BIN = Path(sys.executable).parent
 
@@ -365,12 +365,18 @@ def switch(env: dict[str, str], mode: str, within: float = 30.0) -> tuple[bool, 
 
     In OL the observer is off the lockstep critical path: on a loaded machine it may lag more than
     the controller's warm window, and the switch is then refused (as designed) until it catches up.
+    Also asked again when no answer came (``waits.RESEND_S``: the response may have been dropped;
+    setting the mode it already has again changes nothing).
     """
-    answer: tuple[bool, str] = (False, "")
+    answer: tuple[bool, str] = (False, "no answer")
 
     def answered() -> bool:
         nonlocal answer
-        answer = set_parameter(env, "controller_node", "mode", mode)
+        try:
+            answer = set_parameter(env, "controller_node", "mode", mode, timeout=RESEND_S)
+        except TimeoutError as exc:
+            answer = (False, str(exc))
+            return False
         return answer[0] or "not flowing" not in answer[1]
 
     wait_until(answered, within, poll_s=0.5)

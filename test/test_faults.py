@@ -228,7 +228,14 @@ def test_a_bag_recorded_across_a_node_kill_is_readable_and_analysable(root, tmp_
         time.sleep(1.0)
         t_restart = time.monotonic()
         restart(procs, "environment_node", env, tmp_path, config, sets)
-        assert wait_for_effort(col, t_restart, 4000, 60), "the loop did not resume"
+        if not wait_for_effort(col, t_restart, 4000, 60):
+            t, _, e = efforts(col)
+            pytest.fail(
+                f"the loop did not resume: {np.sum(np.abs(e[t > t_restart]) > 0.1)} pushing "
+                f"samples of {np.sum(t > t_restart)} since the restart; environment_node: "
+                f"{procs['environment_node'].output()[-1500:]}; the rest: "
+                f"{procs['device_node'].output()[-1500:]}"
+            )
         os.killpg(rec.proc.pid, signal.SIGINT)
         assert rec.wait(30) == 0, rec.output()
     finally:

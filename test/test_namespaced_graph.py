@@ -23,10 +23,11 @@ from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import parameter_value_to_python
 from rclpy.parameter_client import AsyncParameterClient
+from rclpy.task import Future
 
 from haptic_dob.runtime.params import load_node_params, node_view
 from rosgraph import Process, isolated_env
-from waits import wait_until
+from waits import answered, wait_until
 
 pytestmark = [pytest.mark.multiprocess]
 
@@ -56,17 +57,22 @@ class Probe:
         """Spin until ``condition`` (a hang guard, not a timing bound)."""
         return wait_until(condition, timeout, step=lambda: self.ex.spin_once(timeout_sec=0.05))
 
+    def ask(self, send: Callable[[], Future]) -> Future:
+        """The future of a request ``send()`` makes, spun until answered (sent again while the
+        answer does not come, ``waits.answered``; 60 s hang guard)."""
+        return answered(send, 60.0, step=lambda: self.ex.spin_once(timeout_sec=0.05))
+
     def get(self, node: str, names: list[str]) -> dict[str, Any]:
         """The values of those of ``names`` that ``node`` declares (``ros2 param list``, then
         ``ros2 param get``: the service answers nothing when one name is not declared)."""
         client = AsyncParameterClient(self.node, node)
         assert client.wait_for_services(timeout_sec=120.0), f"no parameter services of {node}"
-        listed = client.list_parameters()
-        assert self.until(listed.done, 60.0), f"no answer from {node}"
+        listed = self.ask(client.list_parameters)
+        assert listed.done(), f"no answer from {node}"
         declared = set(listed.result().result.names)
         names = [n for n in names if n in declared]
-        future = client.get_parameters(names)
-        assert self.until(future.done, 60.0), f"no answer from {node}"
+        future = self.ask(lambda: client.get_parameters(names))
+        assert future.done(), f"no answer from {node}"
         values = future.result().values
         return {n: parameter_value_to_python(v) for n, v in zip(names, values, strict=True)}
 

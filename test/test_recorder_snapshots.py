@@ -30,6 +30,7 @@ class Client:
     ready: bool = True
     requests: list[Any] = field(default_factory=list)
     futures: list[Future] = field(default_factory=list)
+    removed: list[Future] = field(default_factory=list)
 
     def service_is_ready(self) -> bool:
         return self.ready
@@ -38,6 +39,9 @@ class Client:
         self.requests.append(request)
         self.futures.append(Future())
         return self.futures[-1]
+
+    def remove_pending_request(self, future: Future) -> None:
+        self.removed.append(future)
 
 
 def tracker(timeout_s: float = 2.0) -> SnapshotTracker[Client]:
@@ -69,19 +73,19 @@ def test_parameters_are_listed_then_got() -> None:
     t = tracker()
     lister, getter = Client(ready=False), Client()
     t.ask("/ns/device_node", 10.0, 5, lister, getter)
-    assert t.step().answered == [] and lister.requests == []  # no service yet
+    assert t.step(10.0).answered == [] and lister.requests == []  # no service yet
     lister.ready = True
-    t.step()
+    t.step(10.5)
     assert lister.requests == [("list", 0)]
-    t.step()  # no answer yet: nothing asked again
+    t.step(12.5)  # no answer yet, within the timeout: nothing asked again
     assert len(lister.requests) == 1 and getter.requests == []
     lister.futures[0].value = SimpleNamespace(result=SimpleNamespace(names=["a", "b"]))
     lister.futures[0].ready = True
-    assert t.step().answered == []
+    assert t.step(12.6).answered == []
     assert getter.requests == [("get", ("a", "b"))]
     getter.futures[0].value = SimpleNamespace(values=("va", "vb"))
     getter.futures[0].ready = True
-    done = t.step()
+    done = t.step(12.7)
     assert done.answered == [ParameterSnapshot("/ns/device_node", ["a", "b"], ["va", "vb"])]
     assert [s.node for s in done.ended] == ["/ns/device_node"]
     assert done.ended[0].list_client is lister and done.ended[0].get_client is getter
@@ -92,10 +96,35 @@ def test_a_failed_call_ends_without_a_snapshot() -> None:
     t = tracker()
     lister = Client()
     t.ask("/ns/device_node", 10.0, 5, lister, Client())
-    t.step()
+    t.step(10.0)
     lister.futures[0].ready = True  # result None: the call failed
-    done = t.step()
+    done = t.step(10.1)
     assert done.answered == [] and [s.node for s in done.ended] == ["/ns/device_node"]
+
+
+def test_a_question_without_an_answer_is_asked_again_every_timeout() -> None:
+    """A lost response (rmw_fastrtps drops it when the node has not matched the client's response
+    reader yet) does not leave the node unasked: each question goes again after the timeout."""
+    t = tracker(timeout_s=2.0)
+    lister, getter = Client(), Client()
+    t.ask("/ns/device_node", 10.0, 5, lister, getter)
+    t.step(10.0)
+    t.step(12.0)  # exactly the timeout: not yet
+    assert len(lister.requests) == 1 and lister.removed == []
+    t.step(12.1)
+    assert lister.requests == [("list", 0)] * 2 and lister.removed == [lister.futures[0]]
+    t.step(14.0)  # the timeout counts from the question asked again
+    assert len(lister.requests) == 2
+    lister.futures[1].value = SimpleNamespace(result=SimpleNamespace(names=["a"]))
+    lister.futures[1].ready = True
+    t.step(14.2)
+    assert getter.requests == [("get", ("a",))]
+    t.step(16.3)  # the get is asked again too
+    assert getter.requests == [("get", ("a",))] * 2 and getter.removed == [getter.futures[0]]
+    getter.futures[1].value = SimpleNamespace(values=("va",))
+    getter.futures[1].ready = True
+    done = t.step(16.4)
+    assert done.answered == [ParameterSnapshot("/ns/device_node", ["a"], ["va"])]
 
 
 def test_progress_is_held_until_answered_or_timed_out() -> None:

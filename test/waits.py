@@ -9,9 +9,18 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import TypeVar
+from typing import Protocol, TypeVar
 
 T = TypeVar("T")
+
+
+class Future(Protocol):
+    """The part of an rclpy future a wait uses."""
+
+    def done(self) -> bool: ...
+
+
+F = TypeVar("F", bound=Future)
 
 
 def wait_until(
@@ -36,3 +45,35 @@ def wait_until(
             step()
         else:
             time.sleep(poll_s)
+
+
+#: wall seconds without an answer after which a service request is sent again: rmw_fastrtps
+#: drops a response when the server has not matched the client's response reader within 100 ms
+#: of answering (ros2/rmw_fastrtps#390), which happens on a loaded machine right after discovery;
+#: the client then waits for an answer that never comes
+RESEND_S = 5.0
+
+
+def answered(
+    send: Callable[[], F],
+    timeout_s: float,
+    *,
+    step: Callable[[], object],
+    resend_s: float = RESEND_S,
+) -> F:
+    """The future of a service request that answered: ``send()`` a request (it returns an rclpy
+    future), ``step()`` (spin) until it is done, and send it again after ``resend_s`` (s) without
+    an answer (an earlier request that answers late counts); after ``timeout_s`` (s, a hang
+    guard) the last future, not done."""
+    end = time.monotonic() + timeout_s
+    sent: list[F] = []
+    while True:
+        sent.append(send())
+        again = min(end, time.monotonic() + resend_s)
+        while time.monotonic() < again:
+            done = [f for f in sent if f.done()]
+            if done:
+                return done[0]
+            step()
+        if time.monotonic() >= end:
+            return next((f for f in sent if f.done()), sent[-1])

@@ -162,7 +162,7 @@ class RecorderNode(LoopNode):
                     self.create_client(ListParameters, f"{node}/list_parameters"),
                     self.create_client(GetParameters, f"{node}/get_parameters"),
                 )
-        self._step_snapshots()
+        self._step_snapshots(now)
         timeout = self.snapshots.timeout_s
         for snap in self.snapshots.overdue(now):
             self.log.warning(
@@ -170,9 +170,10 @@ class RecorderNode(LoopNode):
                 "(until then the bag does not know them)"
             )
 
-    def _step_snapshots(self) -> None:
-        """Ask each pending node one step further; write what came, drop the finished clients."""
-        done = self.snapshots.step()
+    def _step_snapshots(self, now_s: float) -> None:
+        """Ask each pending node one step further at monotonic ``now_s`` (s); write what came,
+        drop the finished clients."""
+        done = self.snapshots.step(now_s)
         for answer in done.answered:
             self._write_snapshot(answer)
         for snap in done.ended:
@@ -215,7 +216,7 @@ class RecorderNode(LoopNode):
         deadline = time.monotonic() + self.params.values["drain_timeout_s"]
         while self.snapshots.pending and time.monotonic() < deadline:
             ex.spin_once(timeout_sec=0.02)
-            self._step_snapshots()
+            self._step_snapshots(time.monotonic())
 
     def close(self) -> None:
         """Drain, write the counts into the bag's metadata and close it (idempotent)."""

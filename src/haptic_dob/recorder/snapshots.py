@@ -3,8 +3,11 @@
 Every node of the recorder's namespaces (its own, or those it is given: a teleoperation graph's
 ``/master`` and ``/slave``; not hidden ones nor the recorder) is asked once,
 when it appears: ``list_parameters``, then ``get_parameters`` of every name. A node silent for
-the timeout is reported once and still asked (a loaded node answers late, and a client dropped
-under a pending request makes the node's own executor fail to send its response). Until a node
+the timeout is reported once and still asked: the question is sent again every timeout (a loaded
+node answers late, and rmw_fastrtps drops a response when the node has not yet matched the
+asking client's response reader 100 ms after answering, which happens right after discovery on a
+loaded machine; a client dropped under a pending request makes the node's own executor fail to
+send its response, so the recorder keeps its clients until the node answered). Until a node
 answered or timed out, the progress the recorder reports is held where that node appeared, so
 a short lockstep run cannot end before the bag knows the session's parameters.
 """
@@ -25,6 +28,10 @@ class ServiceClient(Protocol):
 
     def call_async(self, request: Any) -> Any:
         """Send ``request``; a future with ``done()`` and ``result()`` (None: the call failed)."""
+        ...
+
+    def remove_pending_request(self, future: Any) -> None:
+        """Forget the request of ``future`` (asked again instead)."""
         ...
 
 
@@ -50,6 +57,7 @@ class PendingSnapshot(Generic[C]):
     list_client: C
     get_client: C
     future: Any = None  # of the question asked
+    asked_s: float = 0.0  # when it was asked (monotonic, s)
     names: list[str] | None = None  # once listed
     warned: bool = False  # timed out (and reported)
 
@@ -106,11 +114,12 @@ class SnapshotTracker(Generic[C]):
         """Start asking ``node`` (at monotonic ``now_s``, the recorder at ``progress_ns``)."""
         self.pending.append(PendingSnapshot(node, now_s, progress_ns, list_client, get_client))
 
-    def step(self) -> SnapshotRound[C]:
-        """One step of asking every pending node; the answered and ended ones leave."""
+    def step(self, now_s: float) -> SnapshotRound[C]:
+        """One step of asking every pending node at monotonic ``now_s`` (s); the answered and
+        ended ones leave."""
         out: SnapshotRound[C] = SnapshotRound()
         for snap in list(self.pending):
-            done, answer = self._advance(snap)
+            done, answer = self._advance(snap, now_s)
             if answer is not None:
                 out.answered.append(answer)
             if done:
@@ -129,11 +138,18 @@ class SnapshotTracker(Generic[C]):
         """``progress_ns``, held where a node appeared while it has not answered or timed out."""
         return min([progress_ns, *(s.progress_ns for s in self.pending if not s.warned)])
 
-    def _advance(self, snap: PendingSnapshot[C]) -> tuple[bool, ParameterSnapshot | None]:
+    def _advance(
+        self, snap: PendingSnapshot[C], now_s: float
+    ) -> tuple[bool, ParameterSnapshot | None]:
         """(done, its parameters if they came) after one step of asking ``snap``."""
-        if snap.future is not None:
-            if not snap.future.done():
+        if snap.future is not None and not snap.future.done():
+            if now_s - snap.asked_s <= self.timeout_s:
                 return False, None
+            # no answer within the timeout: the response may be lost, ask again
+            client = snap.list_client if snap.names is None else snap.get_client
+            client.remove_pending_request(snap.future)
+            snap.future = None
+        if snap.future is not None:
             result, snap.future = snap.future.result(), None
             if result is None:
                 return True, None
@@ -145,4 +161,6 @@ class SnapshotTracker(Generic[C]):
                 snap.future = snap.list_client.call_async(self._list_request())
         elif snap.get_client.service_is_ready():
             snap.future = snap.get_client.call_async(self._get_request(snap.names))
+        if snap.future is not None:
+            snap.asked_s = now_s
         return False, None
