@@ -16,7 +16,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -253,6 +253,23 @@ class Collector:
         with self._lock:
             raw = [m for _, m in self.records[topic]]
         return [decode(m) for m in raw]
+
+    def decoded(self, topic: str) -> Callable[[], list[Any]]:
+        """A function returning the decoded messages of ``topic`` received so far, each decoded
+        once: for a poll (decoding every message on every poll grows with the run and, on a
+        loaded machine, takes the CPU from the graph the test watches)."""
+        from haptic_msgs_py.wire import decoder
+
+        decode = decoder(self.topics[topic])
+        done: list[Any] = []
+
+        def messages() -> list[Any]:
+            with self._lock:
+                new = [m for _, m in self.records[topic][len(done) :]]
+            done.extend(decode(m) for m in new)
+            return done
+
+        return messages
 
     def close(self) -> None:
         import rclpy

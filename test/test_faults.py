@@ -43,19 +43,29 @@ def others(victim: str) -> list[str]:
     return [n for n in LOOP if n != victim]
 
 
-def efforts(col: Collector) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(receive time, stamp s, effort) of every joint_states so far."""
-    from haptic_msgs_py.wire import decoder
+class Efforts:
+    """(receive time, stamp s, effort) of every joint_states ``col`` received so far, each message
+    decoded once: decoding them all on every poll grew with the run (20 000 samples: a core of
+    this process busy, starving the loop it watches on a loaded machine)."""
 
-    decode = decoder(SESSION_TOPICS[JOINT_STATES])
-    with col._lock:
-        raw = list(col.records[JOINT_STATES])
-    msgs = [(t, decode(b)) for t, b in raw]
-    return (
-        np.array([t for t, _ in msgs]),
-        np.array([stamp_ns(m) * 1e-9 for _, m in msgs]),
-        np.array([m.effort[0] for _, m in msgs]),
-    )
+    def __init__(self, col: Collector) -> None:
+        from haptic_msgs_py.wire import decoder
+
+        self.col = col
+        self.decode = decoder(SESSION_TOPICS[JOINT_STATES])
+        self.t: list[float] = []
+        self.stamp: list[float] = []
+        self.effort: list[float] = []
+
+    def __call__(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        with self.col._lock:
+            new = self.col.records[JOINT_STATES][len(self.t) :]
+        for t, b in new:
+            m = self.decode(b)
+            self.t.append(t)
+            self.stamp.append(stamp_ns(m) * 1e-9)
+            self.effort.append(m.effort[0])
+        return np.array(self.t), np.array(self.stamp), np.array(self.effort)
 
 
 def last_nonzero_command(col: Collector) -> float:
@@ -118,12 +128,13 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
             EFFORT_COMMAND: SESSION_TOPICS[EFFORT_COMMAND],
         },
     )
+    efforts = Efforts(col)
     procs = start_nodes(config, env, sets, tmp_path, groups=[others(victim)])
     try:
         # the loop runs: the hand pushes into the wall, the effort is the wall's push-back
 
         def pushing() -> bool:
-            _, _, e = efforts(col)
+            _, _, e = efforts()
             return bool(e.size > 500 and np.all(np.abs(e[-200:]) > 0.1))
 
         if not wait_until(pushing, 40, poll_s=0.2):
@@ -137,16 +148,16 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         # process may take the samples half a second late, and the device skips the ticks it
         # slept through); bounded in samples of the device
         def zeroed() -> bool:
-            _, _, e = efforts(col)
+            _, _, e = efforts()
             return bool(e.size > HELD_ZERO and not np.any(e[-HELD_ZERO:]))
 
         if not wait_until(zeroed, 20, poll_s=0.2):
-            _, _, e = efforts(col)
+            _, _, e = efforts()
             pytest.fail(
                 f"the effort did not stay at zero after the kill (the last efforts {e[-5:]}): "
                 + procs["device_node"].output()[-1500:]
             )
-        t, stamps, e = efforts(col)
+        t, stamps, e = efforts()
         before = t < t_kill
         after = ~before
         # the force is zero from some sample after the kill to the end (the node stays dead)
@@ -181,11 +192,11 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         restart(procs, victim, env, tmp_path, config, sets)
 
         def resumed() -> bool:
-            t, _, e = efforts(col)
+            t, _, e = efforts()
             return bool(np.sum(np.abs(e[t > t_restart]) > 0.1) > 200)
 
         if not wait_until(resumed, 40, poll_s=0.2):
-            _, _, e = efforts(col)
+            _, _, e = efforts()
             pytest.fail(
                 f"the loop did not resume after restarting {victim} ({e.size} samples, the last "
                 f"efforts {e[-5:]}); {victim}: {procs[victim].output()[-1500:]}; the rest: "
@@ -193,18 +204,20 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
             )
         # ... and keeps coming (a snapshot of the last samples could fall in a watchdog trip
         # when this loaded machine stalls a process for more than the 5 ms command timeout)
-        assert wait_for_effort(col, t_restart, 400, 20), f"the loop did not stay closed: {victim}"
+        assert wait_for_effort(efforts, t_restart, 400, 20), (
+            f"the loop did not stay closed: {victim}"
+        )
         assert after.any()
     finally:
         stop_all(procs)
         col.close()
 
 
-def wait_for_effort(col: Collector, since: float, n: int, timeout: float) -> bool:
+def wait_for_effort(efforts: Efforts, since: float, n: int, timeout: float) -> bool:
     """``n`` samples with a pushing effort (> 0.1 N) arrived after ``since`` (monotonic s)."""
 
     def enough() -> bool:
-        t, _, e = efforts(col)
+        t, _, e = efforts()
         return bool(np.sum(np.abs(e[t > since]) > 0.1) >= n)
 
     return wait_until(enough, timeout, poll_s=0.2)
@@ -219,17 +232,18 @@ def test_a_bag_recorded_across_a_node_kill_is_readable_and_analysable(root, tmp_
     sets = ["device_node:clock_mode=realtime", "device_node:duration_s=0.0"]
     bag = tmp_path / "across_kill"
     col = Collector(env, {JOINT_STATES: SESSION_TOPICS[JOINT_STATES]})
+    efforts = Efforts(col)
     rec = Process([tool("haptic-record"), str(bag)], env, tmp_path / "record.log")
     procs = start_nodes(config, env, sets, tmp_path, groups=[others("environment_node")])
     try:
-        assert wait_for_effort(col, 0.0, 4000, 60), procs["device_node"].output()[-2000:]
+        assert wait_for_effort(efforts, 0.0, 4000, 60), procs["device_node"].output()[-2000:]
         os.kill(procs["environment_node"].proc.pid, signal.SIGKILL)
         procs["environment_node"].proc.wait(5)
         time.sleep(1.0)
         t_restart = time.monotonic()
         restart(procs, "environment_node", env, tmp_path, config, sets)
-        if not wait_for_effort(col, t_restart, 4000, 60):
-            t, _, e = efforts(col)
+        if not wait_for_effort(efforts, t_restart, 4000, 60):
+            t, _, e = efforts()
             pytest.fail(
                 f"the loop did not resume: {np.sum(np.abs(e[t > t_restart]) > 0.1)} pushing "
                 f"samples of {np.sum(t > t_restart)} since the restart; environment_node: "

@@ -168,8 +168,10 @@ def test_signals_leave_readable_bags_and_a_live_switch_splits_the_session(root, 
     ]
     graph = launch(str(root / "config" / "slide_sim.yaml"), env, sets, tmp_path / "launch.log")
 
+    progress_msgs = col.decoded(RECORDER_PROGRESS)
+
     def progress() -> float:
-        msgs = col.messages(RECORDER_PROGRESS)
+        msgs = progress_msgs()
         return max((m.stamp.sec + m.stamp.nanosec * 1e-9 for m in msgs), default=0.0)
 
     def reach(seconds: float, timeout: float) -> None:
