@@ -224,7 +224,7 @@ class ChannelNode(LoopNode):
 
 def main(args: list[str] | None = None) -> int:
     """``ros2 run haptic_dob channel_node``."""
-    return main_for(ChannelNode, args)
+    return main_for(ChannelNode, args, channel_node_specs())
 
 
 if __name__ == "__main__":

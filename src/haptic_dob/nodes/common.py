@@ -66,10 +66,63 @@ def process_specs() -> list[ParamSpec]:
     ]
 
 
-def main_for(node_class: type, args: list[str] | None = None) -> int:
-    """``main()`` of a single-node executable: spin it until Ctrl-C/SIGTERM."""
+def usage(node_class: type, specs: list[ParamSpec]) -> str:
+    """``--help`` of a node executable: how to run it, what it does, its parameters."""
+    import sys
+    import textwrap
+
+    doc = (sys.modules[node_class.__module__].__doc__ or "").strip().split("\n\n")[0]
+    name = node_class.__module__.rsplit(".", 1)[-1]
+    package = node_class.__module__.split(".", 1)[0]
+    lines = [
+        f"usage: ros2 run {package} {name} [--ros-args [-p NAME:=VALUE] [--params-file FILE] ...]",
+        "",
+        textwrap.fill(" ".join(doc.replace("``", "").split()), 100),
+        "",
+        "parameters (NAME = default, when it may change; ros2 param describe shows the same):",
+    ]
+    for spec in specs:
+        when = "at start-up" if spec.read_only else "at run time"
+        default = repr(spec.default) if isinstance(spec.default, str) else spec.default
+        head = f"  {spec.name} = {default}" + (f" {spec.unit}" if spec.unit else "")
+        if spec.min is not None or spec.max is not None:
+            low = "-inf" if spec.min is None else f"{spec.min:g}"
+            high = "inf" if spec.max is None else f"{spec.max:g}"
+            head += f", in [{low}, {high}]"
+        if spec.choices:
+            head += ", one of " + " | ".join(spec.choices)
+        lines.append(f"{head}, {when}")
+        lines += textwrap.wrap(
+            spec.description, 100, initial_indent=" " * 6, subsequent_indent=" " * 6
+        )
+    return "\n".join(lines)
+
+
+def main_for(node_class: type, args: list[str] | None, specs: list[ParamSpec]) -> int:
+    """``main()`` of a single-node executable: spin it until Ctrl-C/SIGTERM. ``--help`` prints
+    ``usage`` with ``specs``; any other argument before ``--ros-args`` is refused (exit 2)."""
+    import os
+    import sys
+
+    from rclpy.utilities import remove_ros_args
+
+    argv = list(sys.argv if args is None else args)
+    own = remove_ros_args(argv)[1:]
+    if own[:1] in (["-h"], ["--help"]):
+        try:
+            print(usage(node_class, specs), flush=True)
+        except BrokenPipeError:  # the reader went away (``| head``): stop quietly
+            sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - nothing more may reach the pipe
+        return 0
+    if own:
+        print(
+            f"ERROR: unexpected argument {own[0]!r}: parameters go after --ros-args "
+            "(-p NAME:=VALUE or --params-file FILE); --help lists them",
+            file=sys.stderr,
+        )
+        return 2
     from haptic_dob.runtime.ros.spin import run_nodes
     from haptic_msgs_py.ament import ensure_ament_prefix
 
     ensure_ament_prefix()
-    return run_nodes(lambda ctx: [node_class(context=ctx)], args)
+    return run_nodes(lambda ctx: [node_class(context=ctx)], argv)

@@ -246,7 +246,7 @@ class ControllerNode(LoopNode):
 
 def main(args: list[str] | None = None) -> int:
     """``ros2 run haptic_dob controller_node``."""
-    return main_for(ControllerNode, args)
+    return main_for(ControllerNode, args, controller_node_specs())
 
 
 if __name__ == "__main__":

@@ -121,7 +121,7 @@ class EnvironmentNode(LoopNode):
 
 def main(args: list[str] | None = None) -> int:
     """``ros2 run haptic_dob environment_node``."""
-    return main_for(EnvironmentNode, args)
+    return main_for(EnvironmentNode, args, environment_node_specs())
 
 
 if __name__ == "__main__":

@@ -167,7 +167,7 @@ class ObserverNode(LoopNode):
 
 def main(args: list[str] | None = None) -> int:
     """``ros2 run haptic_dob observer_node``."""
-    return main_for(ObserverNode, args)
+    return main_for(ObserverNode, args, observer_node_specs())
 
 
 if __name__ == "__main__":

@@ -242,7 +242,7 @@ class RecorderNode(LoopNode):
 
 def main(args: list[str] | None = None) -> int:
     """``ros2 run haptic_dob recorder_node``."""
-    return main_for(RecorderNode, args)
+    return main_for(RecorderNode, args, recorder_specs())
 
 
 if __name__ == "__main__":

@@ -113,7 +113,7 @@ class SlaveControllerNode(LoopNode):
 
 def main(args: list[str] | None = None) -> int:
     """``ros2 run haptic_dob slave_controller_node``."""
-    return main_for(SlaveControllerNode, args)
+    return main_for(SlaveControllerNode, args, slave_controller_node_specs())
 
 
 if __name__ == "__main__":

@@ -251,7 +251,7 @@ def scheduling() -> str:
 
 def main(args: list[str] | None = None) -> int:
     """``ros2 run haptic_sim device_node``."""
-    return main_for(DeviceNode, args)
+    return main_for(DeviceNode, args, device_node_specs())
 
 
 if __name__ == "__main__":
