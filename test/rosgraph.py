@@ -20,7 +20,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from waits import RESEND_S, wait_until
+from waits import RESEND_S, answered, wait_until
 
 BIN = Path(sys.executable).parent
 
@@ -311,8 +311,14 @@ def set_parameter(env: dict[str, str], node: str, name: str, value: Any, timeout
 
         ex = SingleThreadedExecutor(context=ctx)
         ex.add_node(n)
-        fut = cli.call_async(req)
-        ex.spin_until_future_complete(fut, timeout_sec=timeout)
+        # asked again while no answer comes (a lost response; the same value set twice is the
+        # same change, a refused one changes nothing either time)
+        fut = answered(
+            lambda: cli.call_async(req),
+            timeout,
+            step=lambda: ex.spin_once(timeout_sec=0.05),
+            resend_s=min(RESEND_S, timeout / 2),
+        )
         ex.shutdown()
         if not fut.done():
             raise TimeoutError(f"/{node}/set_parameters did not answer within {timeout} s")
@@ -382,15 +388,15 @@ def switch(env: dict[str, str], mode: str, within: float = 30.0) -> tuple[bool, 
 
     In OL the observer is off the lockstep critical path: on a loaded machine it may lag more than
     the controller's warm window, and the switch is then refused (as designed) until it catches up.
-    Also asked again when no answer came (``waits.RESEND_S``: the response may have been dropped;
-    setting the mode it already has again changes nothing).
+    A set that got no answer at all (``set_parameter`` asks again within its timeout) is tried
+    again too.
     """
     answer: tuple[bool, str] = (False, "no answer")
 
     def answered() -> bool:
         nonlocal answer
         try:
-            answer = set_parameter(env, "controller_node", "mode", mode, timeout=RESEND_S)
+            answer = set_parameter(env, "controller_node", "mode", mode)
         except TimeoutError as exc:
             answer = (False, str(exc))
             return False
