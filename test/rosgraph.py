@@ -267,7 +267,7 @@ class Collector:
             with self._lock:
                 new = [m for _, m in self.records[topic][len(done) :]]
             done.extend(decode(m) for m in new)
-            return done
+            return list(done)
 
         return messages
 
@@ -393,7 +393,7 @@ def switch(env: dict[str, str], mode: str, within: float = 30.0) -> tuple[bool, 
     """
     answer: tuple[bool, str] = (False, "no answer")
 
-    def answered() -> bool:
+    def accepted() -> bool:
         nonlocal answer
         try:
             answer = set_parameter(env, "controller_node", "mode", mode)
@@ -402,7 +402,7 @@ def switch(env: dict[str, str], mode: str, within: float = 30.0) -> tuple[bool, 
             return False
         return answer[0] or "not flowing" not in answer[1]
 
-    wait_until(answered, within, poll_s=0.5)
+    wait_until(accepted, within, poll_s=0.5)
     return answer
 
 

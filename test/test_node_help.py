@@ -52,7 +52,8 @@ def test_the_controller_help_shows_defaults_units_ranges_and_when_each_changes()
     assert listed == names
 
 
-@pytest.mark.parametrize("stray", ["kf:=25", "--mode", "DOB"])
+# mode:=DOB: rclpy would drop it as a deprecated remap rule and start the node in OL
+@pytest.mark.parametrize("stray", ["kf:=25", "mode:=DOB", "--mode", "DOB"])
 def test_a_stray_argument_gets_one_line_and_exit_2(stray: str) -> None:
     out = run("haptic_dob", "controller_node", stray, "--ros-args", "-p", "kf:=1.0")
     assert out.returncode == 2
@@ -60,3 +61,23 @@ def test_a_stray_argument_gets_one_line_and_exit_2(stray: str) -> None:
         f"ERROR: unexpected argument {stray!r}: parameters go after --ros-args "
         "(-p NAME:=VALUE or --params-file FILE); --help lists them"
     ]
+
+
+def test_an_argument_after_the_ros_arguments_end_is_the_nodes_own() -> None:
+    out = run("haptic_dob", "controller_node", "--ros-args", "-p", "kf:=1.0", "--", "--help")
+    assert out.returncode == 0 and out.stdout.startswith("usage: ros2 run haptic_dob")
+
+
+def test_bad_ros_arguments_get_one_line_and_exit_2(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("a: [\n")
+    out = run("haptic_dob", "controller_node", "--ros-args", "--params-file", str(bad))
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert [line for line in out.stderr.splitlines() if line.startswith("ERROR: ")], out.stderr
+    out = run("haptic_dob", "controller_node", "--ros-args", "--help")
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert (
+        out.stderr.strip()
+        .splitlines()[-1]
+        .startswith("ERROR: unknown ROS argument(s) '--help': after --ros-args come -p NAME:=VALUE")
+    ), out.stderr

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
 
-from haptic_dob.recorder.snapshots import ParameterSnapshot, SnapshotTracker
+from haptic_dob.recorder.snapshots import MAX_ASKED, ParameterSnapshot, SnapshotTracker
 
 
 @dataclass
@@ -104,27 +104,41 @@ def test_a_failed_call_ends_without_a_snapshot() -> None:
 
 def test_a_question_without_an_answer_is_asked_again_every_timeout() -> None:
     """A lost response (rmw_fastrtps drops it when the node has not matched the client's response
-    reader yet) does not leave the node unasked: each question goes again after the timeout."""
+    reader yet) does not leave the node unasked: each question goes again after the timeout; the
+    earlier requests wait on, the first answer counts and the others are dropped."""
     t = tracker(timeout_s=2.0)
     lister, getter = Client(), Client()
     t.ask("/ns/device_node", 10.0, 5, lister, getter)
     t.step(10.0)
     t.step(12.0)  # exactly the timeout: not yet
-    assert len(lister.requests) == 1 and lister.removed == []
+    assert len(lister.requests) == 1
     t.step(12.1)
-    assert lister.requests == [("list", 0)] * 2 and lister.removed == [lister.futures[0]]
+    assert lister.requests == [("list", 0)] * 2 and lister.removed == []
     t.step(14.0)  # the timeout counts from the question asked again
     assert len(lister.requests) == 2
-    lister.futures[1].value = SimpleNamespace(result=SimpleNamespace(names=["a"]))
-    lister.futures[1].ready = True
+    # the first request answers late: it counts, the second is dropped, the values are asked
+    lister.futures[0].value = SimpleNamespace(result=SimpleNamespace(names=["a"]))
+    lister.futures[0].ready = True
     t.step(14.2)
+    assert lister.removed == [lister.futures[1]]
     assert getter.requests == [("get", ("a",))]
     t.step(16.3)  # the get is asked again too
-    assert getter.requests == [("get", ("a",))] * 2 and getter.removed == [getter.futures[0]]
+    assert getter.requests == [("get", ("a",))] * 2
     getter.futures[1].value = SimpleNamespace(values=("va",))
     getter.futures[1].ready = True
     done = t.step(16.4)
     assert done.answered == [ParameterSnapshot("/ns/device_node", ["a"], ["va"])]
+    assert getter.removed == [getter.futures[0]] and t.pending == []
+
+
+def test_at_most_max_asked_requests_of_a_question_wait_at_once() -> None:
+    t = tracker(timeout_s=1.0)
+    lister = Client()
+    t.ask("/ns/device_node", 0.0, 5, lister, Client())
+    for k in range(MAX_ASKED + 2):
+        t.step(1.5 * k)
+    assert len(lister.requests) == MAX_ASKED + 2
+    assert lister.removed == lister.futures[:2]  # the oldest dropped for each new one
 
 
 def test_progress_is_held_until_answered_or_timed_out() -> None:

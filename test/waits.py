@@ -71,9 +71,10 @@ def answered(
         sent.append(send())
         again = min(end, time.monotonic() + resend_s)
         while time.monotonic() < again:
-            done = [f for f in sent if f.done()]
-            if done:
-                return done[0]
+            done = next((f for f in sent if f.done()), None)
+            if done is not None:
+                return done
             step()
-        if time.monotonic() >= end:
-            return next((f for f in sent if f.done()), sent[-1])
+        done = next((f for f in sent if f.done()), None)
+        if done is not None or time.monotonic() >= end:
+            return done if done is not None else sent[-1]

@@ -71,9 +71,11 @@ def usage(node_class: type, specs: list[ParamSpec]) -> str:
     import sys
     import textwrap
 
-    doc = (sys.modules[node_class.__module__].__doc__ or "").strip().split("\n\n")[0]
-    name = node_class.__module__.rsplit(".", 1)[-1]
-    package = node_class.__module__.split(".", 1)[0]
+    module = sys.modules[node_class.__module__]
+    doc = (module.__doc__ or "").strip().split("\n\n")[0]
+    spec = getattr(module, "__spec__", None)  # ``python -m``: the module is __main__
+    dotted = spec.name if spec is not None else node_class.__module__
+    name, package = dotted.rsplit(".", 1)[-1], dotted.split(".", 1)[0]
     lines = [
         f"usage: ros2 run {package} {name} [--ros-args [-p NAME:=VALUE] [--params-file FILE] ...]",
         "",
@@ -98,16 +100,29 @@ def usage(node_class: type, specs: list[ParamSpec]) -> str:
     return "\n".join(lines)
 
 
+def own_args(argv: list[str]) -> list[str]:
+    """The arguments of ``argv`` (``argv[0]`` the program) outside ``--ros-args ... [--]``, as rcl
+    splits them; none is parsed here (rcl reports a bad ROS argument itself). rclpy would drop a
+    bare ``name:=value`` as a deprecated remap rule: it counts as the node's own here."""
+    own, in_ros = [], False
+    for arg in argv[1:]:
+        if arg == "--ros-args":
+            in_ros = True
+        elif in_ros and arg == "--":
+            in_ros = False
+        elif not in_ros:
+            own.append(arg)
+    return own
+
+
 def main_for(node_class: type, args: list[str] | None, specs: list[ParamSpec]) -> int:
     """``main()`` of a single-node executable: spin it until Ctrl-C/SIGTERM. ``--help`` prints
     ``usage`` with ``specs``; any other argument before ``--ros-args`` is refused (exit 2)."""
     import os
     import sys
 
-    from rclpy.utilities import remove_ros_args
-
     argv = list(sys.argv if args is None else args)
-    own = remove_ros_args(argv)[1:]
+    own = own_args(argv)
     if own[:1] in (["-h"], ["--help"]):
         try:
             print(usage(node_class, specs), flush=True)

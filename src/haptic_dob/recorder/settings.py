@@ -73,8 +73,8 @@ def recorder_specs() -> list[ParamSpec]:
         ParamSpec(
             "snapshot_timeout_s",
             2.0,
-            "warn when a node has not answered the parameter snapshot after this long (it is "
-            "still asked)",
+            "warn when a node has not answered the parameter snapshot after this long; it is "
+            "still asked, the question sent again every this long (a response may be lost)",
             "s",
             0.1,
             60.0,

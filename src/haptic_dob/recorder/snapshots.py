@@ -3,11 +3,13 @@
 Every node of the recorder's namespaces (its own, or those it is given: a teleoperation graph's
 ``/master`` and ``/slave``; not hidden ones nor the recorder) is asked once,
 when it appears: ``list_parameters``, then ``get_parameters`` of every name. A node silent for
-the timeout is reported once and still asked: the question is sent again every timeout (a loaded
-node answers late, and rmw_fastrtps drops a response when the node has not yet matched the
-asking client's response reader 100 ms after answering, which happens right after discovery on a
-loaded machine; a client dropped under a pending request makes the node's own executor fail to
-send its response, so the recorder keeps its clients until the node answered). Until a node
+the timeout is reported once and still asked: the question goes again every timeout, the earlier
+requests kept waiting (up to ``MAX_ASKED``), and the first answer counts. A loaded node answers
+late, and rmw_fastrtps drops a response for good when the node has not matched the asking
+client's response reader within 100 ms of answering (ros2/rmw_fastrtps#390), as happens right
+after discovery on a loaded machine. The recorder keeps its clients until the node answered (a
+client dropped under a pending request makes the node's own executor fail to send its response).
+Until a node
 answered or timed out, the progress the recorder reports is held where that node appeared, so
 a short lockstep run cannot end before the bag knows the session's parameters.
 """
@@ -37,6 +39,9 @@ class ServiceClient(Protocol):
 
 C = TypeVar("C", bound=ServiceClient)
 
+#: requests of one question kept waiting for an answer at once (the oldest is dropped for a new)
+MAX_ASKED = 4
+
 
 @dataclass
 class ParameterSnapshot:
@@ -56,8 +61,8 @@ class PendingSnapshot(Generic[C]):
     progress_ns: int  # the recorder's progress then
     list_client: C
     get_client: C
-    future: Any = None  # of the question asked
-    asked_s: float = 0.0  # when it was asked (monotonic, s)
+    futures: list[Any] = field(default_factory=list)  # of the question, asked (again) so far
+    asked_s: float = 0.0  # when it was last asked (monotonic, s)
     names: list[str] | None = None  # once listed
     warned: bool = False  # timed out (and reported)
 
@@ -142,25 +147,30 @@ class SnapshotTracker(Generic[C]):
         self, snap: PendingSnapshot[C], now_s: float
     ) -> tuple[bool, ParameterSnapshot | None]:
         """(done, its parameters if they came) after one step of asking ``snap``."""
-        if snap.future is not None and not snap.future.done():
-            if now_s - snap.asked_s <= self.timeout_s:
+        client = snap.list_client if snap.names is None else snap.get_client
+        answered = next((f for f in snap.futures if f.done()), None)
+        if answered is None:
+            if snap.futures and now_s - snap.asked_s <= self.timeout_s:
                 return False, None
-            # no answer within the timeout: the response may be lost, ask again
-            client = snap.list_client if snap.names is None else snap.get_client
-            client.remove_pending_request(snap.future)
-            snap.future = None
-        if snap.future is not None:
-            result, snap.future = snap.future.result(), None
-            if result is None:
-                return True, None
-            if snap.names is not None:
-                return True, ParameterSnapshot(snap.node, snap.names, list(result.values))
-            snap.names = list(result.result.names)
-        if snap.names is None:
-            if snap.list_client.service_is_ready():
-                snap.future = snap.list_client.call_async(self._list_request())
-        elif snap.get_client.service_is_ready():
-            snap.future = snap.get_client.call_async(self._get_request(snap.names))
-        if snap.future is not None:
-            snap.asked_s = now_s
-        return False, None
+            # not asked yet, or no answer within the timeout (the response may be lost): ask
+            # (again), keeping the earlier requests, whose answer may still come
+            if len(snap.futures) == MAX_ASKED:
+                client.remove_pending_request(snap.futures.pop(0))
+            if client.service_is_ready():
+                request = (
+                    self._list_request() if snap.names is None else self._get_request(snap.names)
+                )
+                snap.futures.append(client.call_async(request))
+                snap.asked_s = now_s
+            return False, None
+        for other in snap.futures:
+            if other is not answered:
+                client.remove_pending_request(other)
+        snap.futures = []
+        result = answered.result()
+        if result is None:
+            return True, None
+        if snap.names is not None:
+            return True, ParameterSnapshot(snap.node, snap.names, list(result.values))
+        snap.names = list(result.result.names)
+        return self._advance(snap, now_s)  # ask for the values at once

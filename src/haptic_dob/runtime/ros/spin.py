@@ -30,7 +30,7 @@ from typing import Any
 
 import rclpy
 from rcl_interfaces.msg import SetParametersResult
-from rclpy._rclpy_pybind11 import RCLError
+from rclpy._rclpy_pybind11 import RCLError, UnknownROSArgsError
 from rclpy.context import Context
 from rclpy.exceptions import InvalidParameterValueException, ParameterException
 from rclpy.executors import Executor, SingleThreadedExecutor
@@ -201,6 +201,15 @@ def run_nodes(
     except RCLError as exc:  # a bad --ros-args (for example a params file that does not parse)
         text = " ".join(str(exc).split()).split(", at /")[0]
         print(f"ERROR: {text}", file=sys.stderr)
+        return 2
+    except UnknownROSArgsError as exc:  # e.g. --ros-args --help
+        print(
+            f"ERROR: unknown ROS argument(s) {str(exc).strip('[]')}: after --ros-args come "
+            "-p NAME:=VALUE, "
+            "--params-file FILE, -r FROM:=TO, --log-level LEVEL ...; --help before --ros-args "
+            "lists the parameters",
+            file=sys.stderr,
+        )
         return 2
     received: list[int] = []
 
