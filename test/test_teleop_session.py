@@ -80,35 +80,40 @@ def free_sweep(cfg: TeleopConfig):
     return run_slave_path(cfg, sweep(p0, (0.08, 0.15, 0.06), (5.3, 6.1, 4.7)), 4.0)
 
 
-def reversals(qd: np.ndarray, within: int) -> np.ndarray:
-    """Samples within ``within`` samples of a joint's velocity changing sign."""
-    near = np.zeros(qd.shape[0], dtype=bool)
-    for j in range(qd.shape[1]):
-        for k in np.flatnonzero(np.diff(np.sign(qd[:, j])) != 0):
-            near[max(0, k - within) : k + within + 1] = True
-    return near
-
-
-def test_moving_freely_the_estimate_stays_small_with_the_identified_friction(config) -> None:
+def test_moving_freely_the_estimate_stays_under_0_2_n_with_the_identified_friction(config) -> None:
     """The slave's joints have friction its URDF lacks; the observer's model carries the friction
-    identified from its joint states (the YAML's values, ``test_the_identification_...``), its
-    Coulomb part turning over the identified speeds. Moving across the workspace the estimate's
-    RMS stays under 0.05 N (measured 0.033 N; 0.175 N with Coulomb as a sign); it exceeds 0.2 N
-    on under 1.5 % of the samples (0.74 %), each near a joint's velocity reversal, where the
-    joint sticks for a moment and its friction is anywhere within +-Fc, and never 0.5 N
-    (0.36 N). With the URDF alone it is over 1 N."""
-    identified = free_sweep(free_config(config, {}))
-    raw = free_sweep(free_config(config, {k: [0.0] for k in FRICTION}))
+    identified from its joint states (the YAML's values, ``test_the_identification_...``).
+    Moving across the workspace, every joint reversing on the way, the estimate stays under
+    0.2 N at every sample (measured: max 0.160 N, RMS 0.014 N) with the disturbance observer and
+    with the momentum observer (0.143 N, 0.013 N). With the URDF alone it is over 1 N."""
     settle = 500  # the observer's start and the ramp
-    e = np.linalg.norm(identified.estimate, axis=1)[settle:]
-    e_raw = np.linalg.norm(raw.estimate, axis=1)[settle:]
+    identified = free_sweep(free_config(config, {}))
+    momentum = free_sweep(free_config(config, {"kind": "momentum", "gain": 200.0}))
+    raw = free_sweep(free_config(config, {k: [0.0] for k in FRICTION}))
     assert np.max(np.linalg.norm(identified.contact, axis=1)) == 0.0
-    assert np.sqrt(np.mean(e * e)) < 0.05
-    assert np.max(e) < 0.5
+    assert np.all(np.diff(np.sign(identified.qd[settle:]), axis=0).any(axis=0))  # all reverse
+    for run in (identified, momentum):
+        e = np.linalg.norm(run.estimate, axis=1)[settle:]
+        assert np.max(e) < 0.2, np.max(e)
+        assert np.sqrt(np.mean(e * e)) < 0.03
+    e_raw = np.linalg.norm(raw.estimate, axis=1)[settle:]
     assert np.sqrt(np.mean(e_raw * e_raw)) > 1.0
-    over = e > 0.2
-    assert np.mean(over) < 0.015
-    assert np.all(reversals(identified.qd[settle:], 60)[over])  # only near a reversal
+
+
+def test_the_simulated_friction_turn_is_one_rk4_steps_over(config) -> None:
+    """The simulator turns each joint's Coulomb friction over ``eps`` chosen from the joint's
+    inverse inertia (``coulomb_smoothing``). The coupled arm's stiffness per physics step, the
+    largest eigenvalue of ``h D^-1 diag(Fc / eps)``, stays at most 1 along the free sweep
+    (measured 0.86; RK4's stages overshoot and chatter from 2: with ``D``'s diagonal alone it
+    was 8.2 at the start, and the friction a period carried was then unrelated to its ends)."""
+    dev = config.slave_device()
+    run = free_sweep(free_config(config, {}))
+    stiffness = np.diag(dev._coulomb / dev._coulomb_eps) * dev.dt_physics
+    worst = max(
+        np.max(np.real(np.linalg.eigvals(np.linalg.solve(dev.model._mass_matrix(q), stiffness))))
+        for q in run.q[::25]
+    )
+    assert worst <= 1.0, worst
 
 
 @pytest.mark.slow
@@ -116,8 +121,8 @@ def test_the_identification_finds_the_slave_friction_the_yaml_carries(config) ->
     """12 s of every joint swinging (a soft joint impedance); the fit on the joint states (the
     rigid body of the URDF, ``identify_arm_friction`` as ``haptic-identify --urdf`` runs it)
     finds each joint's viscous and Coulomb friction and the speed its Coulomb friction turns
-    over, which the YAML's observer carries. The simulator turns it over ``eps`` (its physics
-    step's smoothing: 1 mrad/s on the heavy joints, 16-64 mrad/s on the wrist)."""
+    over, which the YAML's observer carries. The simulator turns it over ``eps`` (1.1-76 mrad/s:
+    ``coulomb_smoothing``)."""
     cfg = free_config(config, {}).override(
         {"/slave/slave_controller_node": {"slave.bandwidth_hz": 4.0}}
     )
@@ -129,16 +134,15 @@ def test_the_identification_finds_the_slave_friction_the_yaml_carries(config) ->
     for key in FRICTION:
         found = np.array(fit[key])
         np.testing.assert_allclose(found, carried[key], atol=0.01)  # the YAML's are these
-        np.testing.assert_allclose(found, truth[key], rtol=0.06)  # the plant's own (<= 5.1 %)
+        np.testing.assert_allclose(found, truth[key], rtol=0.02)  # the plant's own (<= 1.1 %)
     speed = np.array(fit[SPEED])
     np.testing.assert_allclose(speed, carried[SPEED], rtol=0.02)  # the YAML's
     eps = cfg.slave_device()._coulomb_eps  # the simulator's own
-    np.testing.assert_allclose(speed[4:], eps[4:], rtol=0.1)  # the wrist: measured <= 4 %
-    # the heavy joints' 1 mrad/s is the encoders' resolution (1 urad a sample) over a few
-    # samples: found 1.0-2.0 mrad/s (1.0-2.2 with the search at the fit's 20 Hz low-pass)
-    assert np.all((speed[:4] >= 0.5 * eps[:4]) & (speed[:4] <= 2.1 * eps[:4])), speed
+    heavy = eps < 2e-3  # a turn of about two samples (joint 2: 1.07 mrad/s, found 1.26)
+    np.testing.assert_allclose(speed[~heavy], eps[~heavy], rtol=0.03)  # measured <= 0.7 %
+    np.testing.assert_allclose(speed[heavy], eps[heavy], rtol=0.25)
     for j in result.joints:
-        assert j.heldout_rms < 0.05 * j.heldout_rms_rigid, j  # measured 0.2-1.6 %
+        assert j.heldout_rms < 0.02 * j.heldout_rms_rigid, j  # measured 0.01-1.5 %
 
 
 # --- the delayed channel -----------------------------------------------------------------------

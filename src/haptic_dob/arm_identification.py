@@ -6,7 +6,8 @@ URDF's masses and inertias, friction left out); what the measured effort has bey
 per joint as viscous plus Coulomb friction by least squares, with the filters the 1-DOF
 identification uses (``haptic_dob.fit_filters``). The speed ``v_c`` over which the Coulomb
 friction turns is found by a search over a grid (least squares for ``b`` and ``Fc`` at each
-value, the smallest residual wins), on every sample but the filters' ends, slow ones included:
+value, the smallest residual wins; then refined between that value's neighbours by scipy's
+bounded scalar search), on every sample but the filters' ends, slow ones included:
 they are where it shows (a sign model errs by up to ``2 Fc`` there, at every reversal). A turn
 lasts a few milliseconds, which the fit's low-pass (``cutoff_hz``, for the accelerations' noise)
 smears over tens: where the encoders resolve speeds well below the turn's, the search may judge
@@ -26,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.optimize import minimize_scalar
 
 from haptic_dob.fit_filters import IdentificationError, MotionFilters, fit, physical
 from haptic_dob.models._pinocchio import PinocchioModel
@@ -182,15 +184,31 @@ def _turn_speed(
     terms_w: tuple[Arr, Arr, NDArray[np.intp]],
     where: str,
 ) -> float:
-    """The grid's ``v_c`` whose model (``b`` and ``Fc`` by least squares through ``f``) leaves
-    the least residual through ``wide``; ``terms``: (velocity, unexplained effort, samples)."""
+    """The ``v_c`` whose model (``b`` and ``Fc`` by least squares through ``f``) leaves the least
+    residual through ``wide``: the best of the grid, then refined between its neighbours on the
+    grid (scipy's bounded scalar search on ``log v_c``); ``terms``: (velocity, unexplained
+    effort, samples)."""
     v, r, every = terms
     v_w, r_w, every_w = terms_w
-    best = (math.inf, 0.0)
-    for c in COULOMB_SPEEDS:
+
+    def residual(c: float) -> float:
         s = _coulomb(f, v_light, c)
         theta, _, _ = fit(np.column_stack([v[every], s[every]]), r[every], where)
         s_w = s if wide is f else _coulomb(wide, v_light, c)
         e = r_w[every_w] - np.column_stack([v_w[every_w], s_w[every_w]]) @ theta
-        best = min(best, (float(e @ e), c))
-    return best[1]
+        return float(e @ e)
+
+    grid = [residual(c) for c in COULOMB_SPEEDS]
+    i = int(np.argmin(grid))
+    if i == 0:  # a sign
+        return 0.0
+    lo = COULOMB_SPEEDS[i - 1] if i > 1 else COULOMB_SPEEDS[1] ** 2 / COULOMB_SPEEDS[2]
+    hi = COULOMB_SPEEDS[min(i + 1, len(COULOMB_SPEEDS) - 1)]
+    found = minimize_scalar(
+        lambda x: residual(math.exp(x)),
+        bounds=(math.log(lo), math.log(hi)),
+        method="bounded",
+        options={"xatol": 1e-3},
+    )
+    best = math.exp(float(found.x))
+    return best if float(found.fun) < grid[i] else COULOMB_SPEEDS[i]

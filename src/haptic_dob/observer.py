@@ -11,6 +11,13 @@ Discrete update at period T, consistent implicit (backward-Euler) form, stable f
     (D_k + T c I) z_{k+1} = D_k z_k + T c (C q'_k + G_k + friction_k - tau_k - c q'_{k+1})
     d_hat_{k+1} = z_{k+1} + c q'_{k+1}
 
+Multi-DOF models take the friction's impulse over the period from both its ends,
+``(friction_k + friction_{k+1}) / 2`` (the momentum observer's trapezoid): a Coulomb friction
+that turns within one period (a joint reversing) is otherwise held at its value of sample k for
+the whole period, an error of up to ``2 Fc`` for that period (measured on the 7-DOF slave in free
+motion with its own friction: 0.085 N at the tip with the rectangle, 0.009 N with the trapezoid).
+The slide's update keeps the thesis's form.
+
 For the slide the estimate is the disturbance filtered by ``1 / (1 + s m / c)``: time constant
 m/c. This consistent form is the only one whose estimate does not depend on tau and friction; its
 error pole is ``(D + T c_d)^-1 D``. With a constant D (the slide) the update uses the
@@ -137,6 +144,7 @@ class DisturbanceObserver:
         self.dls_threshold_m = positive("dls_threshold_m", dls_threshold_m)
         self.dls_damping_m = positive("dls_damping_m", dls_damping_m)
         self._scalar = self._scalar_path and isinstance(model, SlideModel)
+        self._with_friction = bool(getattr(model, "_has_friction", True))
         self._axis = model.axis if isinstance(model, SlideModel) else np.zeros(3)  # (3,) slide
         self._n = n
         self._eye = np.eye(n)
@@ -198,6 +206,7 @@ class DisturbanceObserver:
         self._h_s: float = 0.0
         self._v_last: float = 0.0
         self._qd_last: Vec = np.zeros(n)
+        self._f_prev: Vec = np.zeros(n)
         self._estimate = np.zeros(n)
 
     @property
@@ -220,8 +229,11 @@ class DisturbanceObserver:
         q_, qd_, tau_ = self._sample(q, qd, tau)
         c, T = self.gain, self.dt
         D, h = self._dynamics(q_, qd_)
+        f = self.model._friction(qd_) if self._with_friction else None
         if self._initialised:
-            rhs = self._D_prev @ self._z + (T * c) * (self._h_prev - tau_ - c * qd_)
+            # the friction's impulse over the period from both its ends (trapezoid)
+            bias = self._h_prev if f is None else self._h_prev + 0.5 * (f - self._f_prev)
+            rhs = self._D_prev @ self._z + (T * c) * (bias - tau_ - c * qd_)
             self._z = cast(Vec, np.linalg.solve(self._D_prev + self._tc_eye, rhs))
             d = self._z + c * qd_
         else:
@@ -229,6 +241,8 @@ class DisturbanceObserver:
             d = np.zeros(self._n)
             self._initialised = True
         self._D_prev, self._h_prev = D, h
+        if f is not None:
+            self._f_prev = f
         return self._output(d, qd_)
 
     def _output(self, d: Vec, qd: Vec) -> Vec:

@@ -7,7 +7,7 @@
   central differences of ``J`` along ``q'``;
 - ``solve``: the linear solve of the accelerations, a 3x3 system by cofactors;
 - ``coulomb_smoothing``: the model's Coulomb friction and the speeds over which the simulated arm
-  smooths its sign (``haptic_sim.arm``).
+  smooths its sign (``haptic_sim.arm``), chosen so that RK4 steps over the turn without chatter.
 """
 
 from __future__ import annotations
@@ -53,13 +53,28 @@ def dynamics_and_tip(model: DeviceModel) -> DynamicsAndTip:
     return generic
 
 
+#: how stiff the smoothed turn may make one physics step: ``h Fc / eps`` times the joint's
+#: inverse inertia, at most this at every configuration checked (RK4's stages overshoot and
+#: chatter from about 2; the 7-DOF slave's coupled shoulder reached 8 with the diagonal alone)
+STEP_STIFFNESS = 0.5
+#: configurations checked: the start and this many drawn within ``SPREAD_RAD`` of it (fixed draw)
+SAMPLES = 100
+SPREAD_RAD = 0.5
+
+
 def coulomb_smoothing(
     model: DeviceModel, dyn: MassAndBias, q0: Vec, h: float
 ) -> tuple[Vec | None, Vec]:
-    """The model's Coulomb friction (None without) and, per joint, the speed ``eps`` where the
-    slope ``Fc / eps`` times the physics step ``h`` (s) is half the joint's inertia at ``q0``
-    (at least 1 mrad/s); ``ValueError`` for a model whose Coulomb friction turns over a speed of
-    its own (``coulomb_speed``, an observer's)."""
+    """The model's Coulomb friction (None without) and, per joint, the speed ``eps`` (rad/s or
+    m/s) over which the simulated arm turns it, ``Fc tanh(q' / eps)``.
+
+    The turn's slope ``Fc / eps`` is a stiffness RK4 must step over: ``eps`` is the smallest
+    (at least 1 mrad/s) for which ``h Fc / eps`` times the joint's inverse inertia (the diagonal
+    of ``D^-1``: the inertia the joint moves with while the others are free, far below ``D``'s
+    diagonal where joints are coupled) stays at most ``STEP_STIFFNESS`` at ``q0`` and at
+    ``SAMPLES`` configurations within ``SPREAD_RAD`` of it. ``ValueError`` for a model whose
+    Coulomb friction turns over a speed of its own (``coulomb_speed``, an observer's).
+    """
     speed = getattr(model, "coulomb_speed", None)
     if speed is not None and np.any(np.asarray(speed) > 0.0):
         raise ValueError(
@@ -69,9 +84,14 @@ def coulomb_smoothing(
     fc = getattr(model, "coulomb", None)
     if fc is None or not np.any(np.asarray(fc) > 0.0):
         return None, np.ones(model.dof)
-    D, _ = dyn(q0, np.zeros(model.dof))
     fc = np.asarray(fc, dtype=np.float64)
-    return fc, np.maximum(2.0 * fc * h / np.diag(D), 1e-3)
+    rng = np.random.default_rng(0)
+    zero = np.zeros(model.dof)
+    inverse_inertia = np.zeros(model.dof)
+    for q in (q0, *(q0 + rng.uniform(-SPREAD_RAD, SPREAD_RAD, (SAMPLES, model.dof)))):
+        D, _ = dyn(q, zero)
+        inverse_inertia = np.maximum(inverse_inertia, np.diag(np.linalg.inv(D)))
+    return fc, np.maximum(fc * h * inverse_inertia / STEP_STIFFNESS, 1e-3)
 
 
 def solve(A: Mat, b: Vec) -> Vec:

@@ -133,7 +133,7 @@ def excitation(
 
 
 #: the low-pass (Hz) through which the slave's turn speeds are searched: its encoders resolve
-#: 1 urad a sample, speeds far below the 1-2 mrad/s its heavy joints' friction turns over
+#: 1 urad a sample, speeds far below the 1.1 mrad/s its heaviest joint's friction turns over
 SLAVE_TURN_CUTOFF_HZ = 50.0
 
 
