@@ -11,12 +11,13 @@ Discrete update at period T, consistent implicit (backward-Euler) form, stable f
     (D_k + T c I) z_{k+1} = D_k z_k + T c (C q'_k + G_k + friction_k - tau_k - c q'_{k+1})
     d_hat_{k+1} = z_{k+1} + c q'_{k+1}
 
-Multi-DOF models take the friction's impulse over the period from both its ends,
-``(friction_k + friction_{k+1}) / 2`` (the momentum observer's trapezoid): a Coulomb friction
-that turns within one period (a joint reversing) is otherwise held at its value of sample k for
-the whole period, an error of up to ``2 Fc`` for that period (measured on the 7-DOF slave in free
-motion with its own friction: 0.085 N at the tip with the rectangle, 0.009 N with the trapezoid).
-The slide's update keeps the thesis's form.
+Every model but the slide takes the friction's impulse over the period from both its ends:
+``friction_k`` above becomes ``(friction_k + friction_{k+1}) / 2`` (the momentum observer's
+trapezoid). A Coulomb friction that turns within one period (a joint reversing) is otherwise held
+at its value of sample k for the whole period, an error of up to ``2 Fc`` for that period
+(measured on the 7-DOF slave in free motion with its own friction: 0.085 N at the tip with
+friction_k, 0.009 N with the trapezoid). A model's ``_has_friction`` False says its friction, if
+any, is part of its bias effort and taken at sample k. The slide's update keeps the thesis's form.
 
 For the slide the estimate is the disturbance filtered by ``1 / (1 + s m / c)``: time constant
 m/c. This consistent form is the only one whose estimate does not depend on tau and friction; its
@@ -144,6 +145,7 @@ class DisturbanceObserver:
         self.dls_threshold_m = positive("dls_threshold_m", dls_threshold_m)
         self.dls_damping_m = positive("dls_damping_m", dls_damping_m)
         self._scalar = self._scalar_path and isinstance(model, SlideModel)
+        # friction apart from the bias effort (DeviceModel._friction), for the trapezoid
         self._with_friction = bool(getattr(model, "_has_friction", True))
         self._axis = model.axis if isinstance(model, SlideModel) else np.zeros(3)  # (3,) slide
         self._n = n

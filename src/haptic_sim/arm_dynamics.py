@@ -53,13 +53,17 @@ def dynamics_and_tip(model: DeviceModel) -> DynamicsAndTip:
     return generic
 
 
-#: how stiff the smoothed turn may make one physics step: ``h Fc / eps`` times the joint's
-#: inverse inertia, at most this at every configuration checked (RK4's stages overshoot and
-#: chatter from about 2; the 7-DOF slave's coupled shoulder reached 8 with the diagonal alone)
+#: how stiff the smoothed turn may make one physics step for one joint: ``h Fc / eps`` times the
+#: joint's inverse inertia, at most this at every configuration checked
 STEP_STIFFNESS = 0.5
-#: configurations checked: the start and this many drawn within ``SPREAD_RAD`` of it (fixed draw)
+#: ... and for the arm: the largest eigenvalue of ``h D^-1 diag(Fc / eps)`` (coupled joints add
+#: up), at most this (RK4's stages overshoot and chatter from about 2; the 7-DOF slave's coupled
+#: shoulder reached 8.2 with ``D``'s diagonal alone)
+STEP_LIMIT = 1.5
+#: configurations checked: the start and this many drawn within ``SPREAD`` of it in every joint
+#: (rad, or m for a prismatic joint; a fixed draw)
 SAMPLES = 100
-SPREAD_RAD = 0.5
+SPREAD = 0.5
 
 
 def coulomb_smoothing(
@@ -72,8 +76,10 @@ def coulomb_smoothing(
     (at least 1 mrad/s) for which ``h Fc / eps`` times the joint's inverse inertia (the diagonal
     of ``D^-1``: the inertia the joint moves with while the others are free, far below ``D``'s
     diagonal where joints are coupled) stays at most ``STEP_STIFFNESS`` at ``q0`` and at
-    ``SAMPLES`` configurations within ``SPREAD_RAD`` of it. ``ValueError`` for a model whose
-    Coulomb friction turns over a speed of its own (``coulomb_speed``, an observer's).
+    ``SAMPLES`` configurations within ``SPREAD`` of it; all of them larger by the same factor if
+    the coupled stiffness, the largest eigenvalue of ``h D^-1 diag(Fc / eps)``, passes
+    ``STEP_LIMIT`` at one of those configurations. ``ValueError`` for a model whose Coulomb
+    friction turns over a speed of its own (``coulomb_speed``, an observer's).
     """
     speed = getattr(model, "coulomb_speed", None)
     if speed is not None and np.any(np.asarray(speed) > 0.0):
@@ -87,11 +93,13 @@ def coulomb_smoothing(
     fc = np.asarray(fc, dtype=np.float64)
     rng = np.random.default_rng(0)
     zero = np.zeros(model.dof)
-    inverse_inertia = np.zeros(model.dof)
-    for q in (q0, *(q0 + rng.uniform(-SPREAD_RAD, SPREAD_RAD, (SAMPLES, model.dof)))):
-        D, _ = dyn(q, zero)
-        inverse_inertia = np.maximum(inverse_inertia, np.diag(np.linalg.inv(D)))
-    return fc, np.maximum(fc * h * inverse_inertia / STEP_STIFFNESS, 1e-3)
+    spread = rng.uniform(-SPREAD, SPREAD, (SAMPLES, model.dof))
+    inverses = [np.linalg.inv(dyn(q, zero)[0]) for q in (q0, *(q0 + spread))]
+    inverse_inertia = np.max([np.diag(m) for m in inverses], axis=0)
+    eps = np.maximum(fc * h * inverse_inertia / STEP_STIFFNESS, 1e-3)
+    slope = h * fc / eps
+    coupled = max(float(np.max(np.linalg.eigvals(m * slope).real)) for m in inverses)
+    return fc, eps * max(1.0, coupled / STEP_LIMIT)
 
 
 def solve(A: Mat, b: Vec) -> Vec:
