@@ -28,10 +28,16 @@ BIN = Path(sys.executable).parent
 def random_domain() -> int:
     """A random ROS domain id in 1-100; under pytest-xdist from this worker's share of that range,
     so that tests running at once never meet on one domain."""
+    return random_domains(1)[0]
+
+
+def random_domains(n: int) -> list[int]:
+    """``n`` different random domain ids from this worker's share (``random_domain``): for graphs
+    a test keeps up at once that must not meet (two draws of one id would join them)."""
     count = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
     worker = int(os.environ.get("PYTEST_XDIST_WORKER", "gw0")[2:] or 0)
     span = 100 // max(1, min(count, 100))
-    return random.randint(1 + worker * span, (worker + 1) * span)
+    return random.sample(range(1 + worker * span, (worker + 1) * span + 1), n)
 
 
 def isolated_env(domain: int | None = None) -> dict[str, str]:

@@ -26,7 +26,7 @@ from rclpy.parameter_client import AsyncParameterClient
 from rclpy.task import Future
 
 from haptic_dob.runtime.params import load_node_params, node_view
-from rosgraph import Process, isolated_env
+from rosgraph import Process, isolated_env, random_domains
 from waits import answered, wait_until
 
 pytestmark = [pytest.mark.multiprocess]
@@ -194,9 +194,10 @@ def test_the_documented_overrides_through_node_processes(tmp_path: Path) -> None
     mine = tmp_path / "mine.yaml"
     mine.write_text("/**/controller_node:\n  ros__parameters:\n    kf: 25.0\n")
     runs = []
+    domains = random_domains(len(OVERRIDES))  # one each: a process on another's domain answers
     try:
-        for case, (extra, want) in OVERRIDES.items():
-            env = isolated_env()
+        for (case, (extra, want)), domain in zip(OVERRIDES.items(), domains, strict=True):
+            env = isolated_env(domain)
             args = [str(mine) if a == "MINE" else a for a in extra]
             argv = [executable("haptic_dob", "controller_node"), "--ros-args"]
             argv += ["--params-file", str(CONFIG), *args]
