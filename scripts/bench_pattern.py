@@ -8,19 +8,20 @@ estimate with the command, which releases the device's next sample, and takes th
 wrench as well (it uses it in CL). The cycle of this graph is
 what DDS and rclpy cost for the pattern with no maths and no node logic: the 4-process lockstep
 cycle compared with (this + the batch cycle) is what the nodes add. Used by
-``benchmarks.py pattern`` and ``margin``; ``peer_node`` is the process set-up ``bench_hop``
-shares.
+``benchmarks.py pattern`` and ``margin``; each process is set up as the hop's
+(``haptic_dob.runtime.ros.dds_hop.peer_node``).
 """
 
 from __future__ import annotations
 
 import itertools
 import multiprocessing
-import os
 import random
 import statistics
 import time
 from typing import Any
+
+from haptic_dob.runtime.ros.dds_hop import peer_node
 
 #: role -> (topics it publishes, topics it waits for before answering)
 ROLES: dict[str, tuple[list[str], list[str]]] = {
@@ -29,19 +30,6 @@ ROLES: dict[str, tuple[list[str], list[str]]] = {
     "observer": (["wrench_estimate"], ["joint_states"]),
     "controller": (["effort_command"], ["wrench_wall", "wrench_estimate"]),
 }
-
-
-def peer_node(name: str, domain: str) -> tuple[Any, Any, Any]:
-    """(context, node, events executor) of a benchmark process on ``domain``, localhost only."""
-    os.environ["ROS_DOMAIN_ID"] = domain
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    import rclpy
-    from rclpy.context import Context
-    from rclpy.experimental import EventsExecutor
-
-    ctx = Context()
-    rclpy.init(context=ctx, args=[])
-    return ctx, rclpy.create_node(name, context=ctx), EventsExecutor(context=ctx)
 
 
 def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:

@@ -1,0 +1,103 @@
+"""The DDS floor of one hop: a ping-pong of a small raw message between two rclpy processes.
+
+What DDS and rclpy alone cost a message between two processes on this machine, now (the
+process wake-ups on each side included): the floor the 4-process loop is measured against in
+the benchmarks (``scripts/bench_margin.py``), and part of the premise the real-time tests of
+that layout check before they ask for 1 kHz (``test/capacity.py``). Each side is a process
+with an events executor and the loop's QoS, on the domain id it is given, localhost only.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import random
+import statistics
+import time
+from typing import Any
+
+WARM_UP = 0.1  # share of the round trips left out at the start
+
+
+def peer_node(name: str, domain: str) -> tuple[Any, Any, Any]:
+    """(context, node, events executor) of a benchmark process on ``domain``, localhost only."""
+    os.environ["ROS_DOMAIN_ID"] = domain
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.experimental.events_executor import EventsExecutor
+
+    ctx = Context()
+    rclpy.init(context=ctx, args=[])
+    return ctx, rclpy.create_node(name, context=ctx), EventsExecutor(context=ctx)
+
+
+def _hop_peer(role: str, n: int, domain: str, out: Any) -> None:
+    """One side of the ping-pong: ``a`` sends and times, ``b`` echoes (raw bytes, events
+    executor, the loop's QoS: reliable volatile publisher, best-effort subscription as the
+    sensor streams take it)."""
+    ctx, node, ex = peer_node(f"hop_{role}", domain)
+    from std_msgs.msg import Header
+
+    from haptic_msgs_py import wire
+    from haptic_msgs_py.ros.qos import LOOP, LOOP_IN_BEST_EFFORT
+
+    send, receive = ("ping", "pong") if role == "a" else ("pong", "ping")
+    pub = node.create_publisher(Header, send, LOOP)
+    state: dict[str, float] = {"got": 0, "t": 0.0}
+    rtts: list[float] = []
+    data = wire.encode(wire.header("base_link"))
+
+    def on_data(msg: bytes) -> None:
+        if role == "b":
+            pub.publish(msg)
+        else:
+            rtts.append(time.perf_counter() - state["t"])
+            state["got"] += 1
+
+    node.create_subscription(Header, receive, on_data, LOOP_IN_BEST_EFFORT, raw=True)
+    ex.add_node(node)
+    end = time.monotonic() + 30.0
+    while pub.get_subscription_count() < 1 and time.monotonic() < end:
+        ex.spin_once(timeout_sec=0.01)
+    if role == "b":
+        end = time.monotonic() + 60.0 + n * 0.01
+        while time.monotonic() < end and ctx.ok():
+            ex.spin_once(timeout_sec=0.05)
+        return
+    time.sleep(0.5)  # the echo's publisher matched too
+    for _ in range(n):
+        state["t"] = time.perf_counter()
+        before = state["got"]
+        pub.publish(data)
+        limit = time.monotonic() + 1.0
+        while state["got"] == before and time.monotonic() < limit:
+            ex.spin_once(timeout_sec=0.1)
+    out.put(rtts)
+
+
+def hop_us(n: int = 3000, domain_id: int | None = None) -> float:
+    """Median one-way latency (µs) of a small raw message between two rclpy processes: half the
+    round trip of a ping-pong of ``n`` messages, the first 10 % left out (warm-up), on
+    ``domain_id`` (None: a random one of 101-200)."""
+    ctx = multiprocessing.get_context("spawn")
+    out = ctx.Queue()
+    domain = str(random.randint(101, 200) if domain_id is None else domain_id)
+    echo = ctx.Process(target=_hop_peer, args=("b", n, domain, out))
+    echo.start()
+    timer = ctx.Process(target=_hop_peer, args=("a", n, domain, out))
+    timer.start()
+    try:
+        rtts = out.get(timeout=120.0 + n * 0.01)
+    finally:
+        timer.join(10)
+        echo.terminate()
+        echo.join(10)
+        for p in (timer, echo):
+            if p.is_alive():
+                p.kill()
+                p.join(5)
+    kept = rtts[int(len(rtts) * WARM_UP) :]
+    if not kept:
+        raise RuntimeError("the ping-pong got no answer")
+    return float(statistics.median(kept)) / 2 * 1e6
