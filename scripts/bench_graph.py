@@ -29,7 +29,7 @@ def graph_args(extra: list[str]) -> list[str]:
     return args if "--processes" in args else [a for a in args if a != "--pin"]
 
 
-def _launch(extra: list[str], sets: list[str], timeout: float) -> str:
+def launch_graph(extra: list[str], sets: list[str], timeout: float) -> str:
     """Run ``haptic-launch slide_sim`` on a fresh domain; return its combined output."""
     env = dict(
         os.environ,
@@ -47,7 +47,7 @@ def _launch(extra: list[str], sets: list[str], timeout: float) -> str:
 
 def real_time_factor(extra: list[str], seconds: float = 20.0) -> float:
     """One lockstep graph run's real-time factor, as the device node reports it."""
-    text = _launch(graph_args(extra), [f"device_node:duration_s={seconds}"], 300)
+    text = launch_graph(graph_args(extra), [f"device_node:duration_s={seconds}"], 300)
     found = re.search(r"real-time factor ([0-9.]+)", text)
     if found is None:
         raise RuntimeError(f"no real-time factor in the launch output: {text[-1500:]}")
@@ -89,7 +89,7 @@ def _realtime(repeat: int, extra: list[str]) -> str:
     for _ in range(repeat):
         with tempfile.TemporaryDirectory() as tmp:
             stats = os.path.join(tmp, "stats.json")
-            _launch(
+            launch_graph(
                 graph_args(extra),
                 [
                     "device_node:clock_mode=realtime",

@@ -6,10 +6,13 @@ The floors: the batch cycle (``bench_batch``: the maths with no transport), thre
 
 from __future__ import annotations
 
+import json
+import os
 import statistics
+import tempfile
 
 from bench_batch import batch_cycle_us
-from bench_graph import lockstep_cycle_us
+from bench_graph import launch_graph, lockstep_cycle_us
 from bench_hop import hop_us
 from bench_pattern import pattern_cycle_us
 
@@ -54,4 +57,37 @@ def bench_margin(repeat: int) -> str:
         f"composed / batch cycle: {ratios(composed)}; 4 processes / (3 hops + batch): "
         f"{ratios(processes)}; 4 processes / (message pattern + batch): {ratios(nodes)}; "
         f"{'; '.join(rows)}"
+    )
+
+
+def bench_realtime_margin(repeat: int) -> str:
+    """The 4-process real-time loop against its DDS floor, as ``test_graph_realtime`` runs it
+    (OL, the controller taking only the wall force, 3 s at 1 kHz): one raw hop measured just
+    before and just after, the graph's median sample-to-command latency over three hops (the
+    slower measurement), and the share of commands before the next tick."""
+    rows, ratios, on_time = [], [], []
+    for _ in range(repeat):
+        h1 = hop_us(2000)
+        with tempfile.TemporaryDirectory() as tmp:
+            stats = os.path.join(tmp, "stats.json")
+            sets = [
+                "device_node:clock_mode=realtime",
+                "device_node:duration_s=3.0",
+                f"device_node:stats_file={stats}",
+                "controller_node:warm_inputs=false",
+            ]
+            launch_graph(["--processes"], sets, 300)
+            with open(stats, encoding="utf-8") as fh:
+                s = json.load(fh)
+        h2 = hop_us(2000)
+        floor_ms = 3 * max(h1, h2) / 1e3
+        ratios.append(s["latency_p50_ms"] / floor_ms)
+        on_time.append(s["on_time_pct"])
+        rows.append(
+            f"hop {h1:.0f}/{h2:.0f} us, p50 {s['latency_p50_ms']:.3f} ms, "
+            f"on time {s['on_time_pct']:.1f} %"
+        )
+    return (
+        f"p50 / 3 hops: median {statistics.median(ratios):.2f}; on time: median "
+        f"{statistics.median(on_time):.1f} %; {'; '.join(rows)}"
     )

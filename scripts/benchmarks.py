@@ -29,7 +29,7 @@ from bench_graph import (
 )
 from bench_hop import bench_hop
 from bench_log import bench_log
-from bench_margin import bench_margin
+from bench_margin import bench_margin, bench_realtime_margin
 from bench_pattern import bench_pattern
 from bench_timer_floor import bench_timer_floor
 
@@ -61,6 +61,7 @@ BENCHMARKS: dict[str, Callable[[int], str]] = {
     "hop": bench_hop,
     "pattern": bench_pattern,
     "margin": bench_margin,
+    "realtime-margin": bench_realtime_margin,
     "log": bench_log,
 }
 
