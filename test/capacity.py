@@ -15,13 +15,13 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import pytest
 
 from haptic_dob.runtime.ros.dds_hop import hop_us
-from rosgraph import isolated_env, random_domain
+from rosgraph import Collector, isolated_env, random_domain
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
@@ -45,19 +45,24 @@ _measured: dict[tuple[tuple[str, ...], ...], float] = {}
 
 
 def lockstep_rtf(
-    groups: Sequence[Sequence[str]], mode: str = "OL", sets: Sequence[str] = ()
+    groups: Sequence[Sequence[str]],
+    mode: str = "OL",
+    sets: Sequence[str] = (),
+    watched: Mapping[str, str] | None = None,
 ) -> float:
     """The lockstep real-time factor of the slide loop with ``groups`` sharing processes (nodes
     in no group alone; ``[]``: four processes), in ``mode``, with ``sets`` (``haptic-launch
-    --set``); measured once per layout."""
-    key = (*(tuple(sorted(g)) for g in groups), (mode, *sets))
+    --set``), and with this process watching the ``watched`` topics (topic -> type) as the
+    calling test will (a ``rosgraph.Collector``: its CPU is the test's load beside the loop,
+    which on one core the loop shares); measured once per layout."""
+    key = (*(tuple(sorted(g)) for g in groups), (mode, *sets), tuple(sorted(watched or {})))
     if key not in _measured:
         argv = [str(BIN / "haptic-launch"), str(ROOT / "config" / "slide_sim.yaml")]
         argv += [a for g in groups for a in ("--group", ",".join(g))] or ["--processes"]
         argv += ["--set", f"device_node:duration_s={MEASURE_S}"]
         argv += ["--set", f"controller_node:mode={mode}", "--set", "controller_node:kf=1.0"]
         argv += [a for s in sets for a in ("--set", s)]
-        _measured[key] = _probe(argv)
+        _measured[key] = _probe(argv, watched)
     return _measured[key]
 
 
@@ -76,12 +81,16 @@ def teleop_lockstep_rtf(composed: bool = True) -> float:
     return _measured[key]
 
 
-def _probe(argv: list[str]) -> float:
-    """Run a lockstep launch; the lowest real-time factor its devices report."""
+def _probe(argv: list[str], watched: Mapping[str, str] | None = None) -> float:
+    """Run a lockstep launch, with a collector of ``watched`` in this process while it runs;
+    the lowest real-time factor its devices report."""
+    env = isolated_env()
+    # no back pressure: the device does not wait for it (as in real time), its CPU is the load
+    col = Collector(env, dict(watched), back_pressure=False) if watched else None
     # inside the test's own timeout, so a stuck probe says what it printed; SIGTERM lets
     # haptic-launch stop the nodes it started (a SIGKILL would orphan them)
     proc = subprocess.Popen(
-        argv, env=isolated_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
     try:
         stdout, stderr = proc.communicate(timeout=PROBE_TIMEOUT_S)
@@ -89,22 +98,30 @@ def _probe(argv: list[str]) -> float:
         proc.terminate()
         stdout, stderr = proc.communicate(timeout=60)
         pytest.fail(f"the capacity probe ran over {PROBE_TIMEOUT_S} s:\n{stderr[-2000:]}")
+    finally:
+        if col is not None:
+            col.close()
     found = re.findall(r"real-time factor ([0-9.]+)", stderr + stdout)
     assert proc.returncode == 0 and found, stderr[-2000:]
     return min(float(f) for f in found)
 
 
 def require_realtime(
-    groups: Sequence[Sequence[str]], mode: str = "OL", sets: Sequence[str] = ()
+    groups: Sequence[Sequence[str]],
+    mode: str = "OL",
+    sets: Sequence[str] = (),
+    watched: Mapping[str, str] | None = None,
 ) -> float:
     """Skip the calling test unless this machine turns this layout over at ``REQUIRED_RTF`` times
-    real time or faster (now, under whatever else runs); returns the figure."""
-    rtf = lockstep_rtf(groups, mode, sets)
+    real time or faster (now, under whatever else runs, with the test watching ``watched``);
+    returns the figure."""
+    rtf = lockstep_rtf(groups, mode, sets, watched)
     if rtf < REQUIRED_RTF:
         layout = " | ".join(", ".join(g) for g in groups) or "four processes"
+        watching = f", this test watching {len(watched)} topics" if watched else ""
         pytest.skip(
-            f"this machine turns the loop ({layout}; {mode}) over at {rtf:.2f}x real time in "
-            f"lockstep, measured now; real time at 1 kHz needs {REQUIRED_RTF:g}x"
+            f"this machine turns the loop ({layout}; {mode}{watching}) over at {rtf:.2f}x real "
+            f"time in lockstep, measured now; real time at 1 kHz needs {REQUIRED_RTF:g}x"
         )
     return rtf
 

@@ -105,7 +105,12 @@ def diagnostics_after(col: Collector, t0: float) -> list[str]:
 def test_kill_9_zeroes_the_force_within_the_command_timeout(
     root, tmp_path, victim, mode, reason
 ) -> None:
-    require_realtime([others(victim)], mode)
+    watched = {
+        JOINT_STATES: SESSION_TOPICS[JOINT_STATES],
+        DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
+        EFFORT_COMMAND: SESSION_TOPICS[EFFORT_COMMAND],
+    }
+    require_realtime([others(victim)], mode, watched=watched)
     env = isolated_env()
     config = root / "config" / "slide_sim.yaml"
     sets = [
@@ -120,14 +125,7 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         "device_node:plant.encoder_resolution_m=1.0e-9",
         "device_node:plant.coulomb_n=0.0",
     ]
-    col = Collector(
-        env,
-        {
-            JOINT_STATES: SESSION_TOPICS[JOINT_STATES],
-            DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
-            EFFORT_COMMAND: SESSION_TOPICS[EFFORT_COMMAND],
-        },
-    )
+    col = Collector(env, watched)
     efforts = Efforts(col)
     procs = start_nodes(config, env, sets, tmp_path, groups=[others(victim)])
     try:
@@ -226,12 +224,13 @@ def wait_for_effort(efforts: Efforts, since: float, n: int, timeout: float) -> b
 def test_a_bag_recorded_across_a_node_kill_is_readable_and_analysable(root, tmp_path) -> None:
     """haptic-record runs through kill -9 and restart of the environment node in real time: it
     stops cleanly, wrote what it received, the gap is in the bag, and haptic-analyze reads it."""
-    require_realtime([others("environment_node")])
+    watched = {JOINT_STATES: SESSION_TOPICS[JOINT_STATES]}
+    require_realtime([others("environment_node")], watched=watched)
     env = isolated_env()
     config = root / "config" / "slide_sim.yaml"
     sets = ["device_node:clock_mode=realtime", "device_node:duration_s=0.0"]
     bag = tmp_path / "across_kill"
-    col = Collector(env, {JOINT_STATES: SESSION_TOPICS[JOINT_STATES]})
+    col = Collector(env, watched)
     efforts = Efforts(col)
     rec = Process([tool("haptic-record"), str(bag)], env, tmp_path / "record.log")
     procs = start_nodes(config, env, sets, tmp_path, groups=[others("environment_node")])
