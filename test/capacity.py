@@ -62,31 +62,38 @@ def lockstep_rtf(
         argv += ["--set", f"device_node:duration_s={MEASURE_S}"]
         argv += ["--set", f"controller_node:mode={mode}", "--set", "controller_node:kf=1.0"]
         argv += [a for s in sets for a in ("--set", s)]
-        _measured[key] = _probe(argv, watched)
+        _measured[key] = _probe(argv, {"": watched} if watched else None)
     return _measured[key]
 
 
-def teleop_lockstep_rtf(composed: bool = True) -> float:
+def teleop_lockstep_rtf(
+    composed: bool = True, watched: Mapping[str, Mapping[str, str]] | None = None
+) -> float:
     """The lockstep real-time factor of the teleoperation graph, the slower device's, each
-    channel end using what has come as in real time (so that each side runs at its own pace);
+    channel end using what has come as in real time (so that each side runs at its own pace),
+    with this process watching ``watched`` (namespace -> topic -> type) as the calling test will;
     measured once per layout: ``composed`` every node in one process, else a process per side
     (real time's default)."""
-    key = (("teleop_sim", "composed" if composed else "sides"),)
+    watching = tuple(f"{ns}/{t}" for ns, topics in sorted((watched or {}).items()) for t in topics)
+    key = (("teleop_sim", "composed" if composed else "sides"), watching)
     if key not in _measured:
         argv = [str(BIN / "haptic-launch"), str(ROOT / "config" / "teleop_sim.yaml")]
         argv += ["--composed"] if composed else ["--group", "master", "--group", "slave"]
         argv += ["--set", "**/channel_node:wait_for_peer=false"]
         argv += ["--set", f"**/device_node:duration_s={MEASURE_S}"]
-        _measured[key] = _probe(argv)
+        _measured[key] = _probe(argv, watched)
     return _measured[key]
 
 
-def _probe(argv: list[str], watched: Mapping[str, str] | None = None) -> float:
-    """Run a lockstep launch, with a collector of ``watched`` in this process while it runs;
-    the lowest real-time factor its devices report."""
+def _probe(argv: list[str], watched: Mapping[str, Mapping[str, str]] | None = None) -> float:
+    """Run a lockstep launch, with collectors of ``watched`` (namespace -> topic -> type) in
+    this process while it runs; the lowest real-time factor its devices report."""
     env = isolated_env()
-    # no back pressure: the device does not wait for it (as in real time), its CPU is the load
-    col = Collector(env, dict(watched), back_pressure=False) if watched else None
+    # no back pressure: the devices do not wait for them (as in real time), their CPU is the load
+    cols = [
+        Collector(env, dict(topics), name=f"probe_{i}", namespace=ns, back_pressure=False)
+        for i, (ns, topics) in enumerate(sorted((watched or {}).items()))
+    ]
     # inside the test's own timeout, so a stuck probe says what it printed; SIGTERM lets
     # haptic-launch stop the nodes it started (a SIGKILL would orphan them)
     proc = subprocess.Popen(
@@ -99,7 +106,7 @@ def _probe(argv: list[str], watched: Mapping[str, str] | None = None) -> float:
         stdout, stderr = proc.communicate(timeout=60)
         pytest.fail(f"the capacity probe ran over {PROBE_TIMEOUT_S} s:\n{stderr[-2000:]}")
     finally:
-        if col is not None:
+        for col in reversed(cols):
             col.close()
     found = re.findall(r"real-time factor ([0-9.]+)", stderr + stdout)
     assert proc.returncode == 0 and found, stderr[-2000:]
@@ -126,13 +133,17 @@ def require_realtime(
     return rtf
 
 
-def require_realtime_teleop(composed: bool = True) -> float:
+def require_realtime_teleop(
+    composed: bool = True, watched: Mapping[str, Mapping[str, str]] | None = None
+) -> float:
     """Skip the calling test unless this machine turns the teleoperation graph in that layout
-    (``teleop_lockstep_rtf``) over at ``REQUIRED_RTF`` times real time or faster in lockstep
-    (now); returns the slower side's figure."""
-    rtf = teleop_lockstep_rtf(composed)
+    (``teleop_lockstep_rtf``, with the test watching ``watched``) over at ``REQUIRED_RTF`` times
+    real time or faster in lockstep (now); returns the slower side's figure."""
+    rtf = teleop_lockstep_rtf(composed, watched)
     if rtf < REQUIRED_RTF:
         layout = "all in one process" if composed else "a process per side"
+        if watched:
+            layout += f", this test watching {sum(len(t) for t in watched.values())} topics"
         pytest.skip(
             f"this machine turns the teleoperation graph ({layout}) over at {rtf:.2f}x real time "
             f"in lockstep (the slower side), measured now; real time at 1 kHz needs "

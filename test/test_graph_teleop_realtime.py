@@ -74,20 +74,13 @@ def vectors(col: Collector, topic: str) -> dict[int, np.ndarray]:
 
 
 def test_realtime_teleop_closes_the_loop_and_falls_back_on_a_dead_link(root, tmp_path) -> None:
-    require_realtime_teleop()
-    env = isolated_env()
-    cols = {
-        "master": Collector(
-            env,
-            {"wrench_desired": "geometry_msgs/msg/WrenchStamped", "/teleop/to_slave": JS},
-            namespace="master",
-        ),
-        "slave": Collector(
-            env,
-            {"pose_desired": "geometry_msgs/msg/PoseStamped", "/teleop/to_master": JS},
-            namespace="slave",
-        ),
+    watched = {
+        "master": {"wrench_desired": "geometry_msgs/msg/WrenchStamped", "/teleop/to_slave": JS},
+        "slave": {"pose_desired": "geometry_msgs/msg/PoseStamped", "/teleop/to_master": JS},
     }
+    require_realtime_teleop(watched=watched)
+    env = isolated_env()
+    cols = {ns: Collector(env, topics, namespace=ns) for ns, topics in watched.items()}
     stats = {ns: tmp_path / f"{ns}.json" for ns in cols}
     sets = [
         "**/device_node:clock_mode=realtime",
