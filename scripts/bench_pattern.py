@@ -1,13 +1,18 @@
-"""The DDS floor of the loop's message pattern: four processes that only pass messages.
+"""The DDS floor of the loop's message pattern: processes that only pass messages.
 
-Four rclpy processes (events executor, raw bytes of a small message, the loop's QoS) pass the
-messages a slide DOB cycle passes between ``--processes`` nodes, and nothing else: the device
-sends pose, twist, joint states and the sensor's wrench; the environment answers pose + twist
-with one message, the observer answers the joint states with one; the controller answers wall +
-estimate with the command, which releases the device's next sample, and takes the sensor's
-wrench as well (it uses it in CL). The cycle of this graph is
-what DDS and rclpy cost for the pattern with no maths and no node logic: the 4-process lockstep
-cycle compared with (this + the batch cycle) is what the nodes add. Used by
+Each pattern is a few rclpy processes (events executor, raw bytes of a small message, the loop's
+QoS) that pass messages and do nothing else; its cycle is what DDS and rclpy cost for that
+pattern with no maths and no node logic. ``loop`` is the messages a slide DOB cycle passes
+between ``--processes`` nodes: the device sends pose, twist, joint states and the sensor's
+wrench; the environment answers pose + twist with one message, the observer answers the joint
+states with one; the controller answers wall + estimate with the command, which releases the
+device's next sample, and takes the sensor's wrench as well (it uses it in CL). The 4-process
+lockstep cycle compared with (``loop`` + the batch cycle) is what the nodes add. The others say
+where the loop's own floor lies against the raw hop (``bench_hop``): ``one-message`` is the same
+four processes with the device sending one message that both the environment and the observer
+take; ``ring`` is three processes passing one message around (device -> environment ->
+controller -> device: the three hops of the margin's floor, in three processes); ``ping-pong``
+is two (device -> controller -> device), which should come out at two hops. Used by
 ``benchmarks.py pattern`` and ``margin``; each process is set up as the hop's
 (``haptic_dob.runtime.ros.dds_hop.peer_node``).
 """
@@ -21,19 +26,39 @@ import statistics
 import time
 from typing import Any
 
-from haptic_dob.runtime.ros.dds_hop import peer_node
+from haptic_dob.runtime.ros.dds_hop import hop_us, peer_node
 
 #: role -> (topics it publishes, topics it waits for before answering)
-ROLES: dict[str, tuple[list[str], list[str]]] = {
-    "device": (["pose", "twist", "joint_states", "wrench_measured"], ["effort_command"]),
-    "environment": (["wrench_wall"], ["pose", "twist"]),
-    "observer": (["wrench_estimate"], ["joint_states"]),
-    "controller": (["effort_command"], ["wrench_wall", "wrench_estimate"]),
+Roles = dict[str, tuple[list[str], list[str]]]
+
+#: pattern name -> its roles (the device times the cycle: it answers the command)
+PATTERNS: dict[str, Roles] = {
+    "loop": {
+        "device": (["pose", "twist", "joint_states", "wrench_measured"], ["effort_command"]),
+        "environment": (["wrench_wall"], ["pose", "twist"]),
+        "observer": (["wrench_estimate"], ["joint_states"]),
+        "controller": (["effort_command"], ["wrench_wall", "wrench_estimate"]),
+    },
+    "one-message": {
+        "device": (["sample"], ["effort_command"]),
+        "environment": (["wrench_wall"], ["sample"]),
+        "observer": (["wrench_estimate"], ["sample"]),
+        "controller": (["effort_command"], ["wrench_wall", "wrench_estimate"]),
+    },
+    "ring": {
+        "device": (["sample"], ["effort_command"]),
+        "environment": (["wrench_wall"], ["sample"]),
+        "controller": (["effort_command"], ["wrench_wall"]),
+    },
+    "ping-pong": {
+        "device": (["sample"], ["effort_command"]),
+        "controller": (["effort_command"], ["sample"]),
+    },
 }
 
 
-def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
-    """One process of the pattern; the device times ``cycles`` cycles and puts the median."""
+def _peer(pattern: str, role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
+    """One process of ``pattern``; the device times ``cycles`` cycles and puts the median."""
     ctx, node, ex = peer_node(f"pattern_{role}", domain)
     from std_msgs.msg import Header
 
@@ -41,7 +66,7 @@ def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
     from haptic_msgs_py.ros.qos import ESTIMATOR_IN, LOOP, LOOP_IN, LOOP_IN_BEST_EFFORT
 
     data = wire.encode(wire.header("base_link"))
-    sends, waits = ROLES[role]
+    sends, waits = PATTERNS[pattern][role]
     pubs = [node.create_publisher(Header, t, LOOP) for t in sends]
     got: set[str] = set()
     ends: list[float] = []
@@ -68,7 +93,7 @@ def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
     qos = {"observer": ESTIMATOR_IN, "device": LOOP_IN}.get(role, LOOP_IN_BEST_EFFORT)
     for t in waits:
         node.create_subscription(Header, t, on(t), qos, raw=True)
-    if role == "controller":  # taken, not waited for
+    if pattern == "loop" and role == "controller":  # taken, not waited for
         node.create_subscription(Header, "wrench_measured", lambda _m: None, qos, raw=True)
     ex.add_node(node)
     settle = time.monotonic() + 5.0  # discovery and matching of every endpoint
@@ -86,13 +111,16 @@ def _peer(role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
     out.put(statistics.median(steps) * 1e6 if steps else None)
 
 
-def pattern_cycle_us(cycles: int = 5000) -> float:
-    """Median cycle (µs) of the loop's message pattern between four processes (first 10 %
-    left out as warm-up)."""
+def pattern_cycle_us(cycles: int = 5000, pattern: str = "loop") -> float:
+    """Median cycle (µs) of ``pattern`` (``PATTERNS``; by default the loop's messages between
+    four processes), the first 10 % left out as warm-up."""
     ctx = multiprocessing.get_context("spawn")
     out, stop = ctx.Queue(), ctx.Event()
     domain = str(random.randint(101, 200))
-    procs = [ctx.Process(target=_peer, args=(r, cycles, domain, stop, out)) for r in ROLES]
+    procs = [
+        ctx.Process(target=_peer, args=(pattern, r, cycles, domain, stop, out))
+        for r in PATTERNS[pattern]
+    ]
     for p in procs:
         p.start()
     try:
@@ -105,14 +133,31 @@ def pattern_cycle_us(cycles: int = 5000) -> float:
                 p.terminate()
                 p.join(5)
     if cycle is None:
-        raise RuntimeError("the message pattern did not turn over")
+        raise RuntimeError(f"the message pattern {pattern!r} did not turn over")
     return float(cycle)
 
 
 def bench_pattern(repeat: int) -> str:
-    """The loop's message pattern between four processes that do nothing else (µs a cycle)."""
-    cycles = [pattern_cycle_us() for _ in range(repeat)]
-    return (
-        f"cycle median {statistics.median(cycles):.0f} us (runs: "
-        f"{', '.join(f'{c:.0f}' for c in cycles)})"
+    """Each message pattern's cycle (µs), the patterns interleaved round by round, with one raw
+    hop measured before and after each round: the ratio of each to as many hops as it passes in
+    sequence says what the topology costs beyond the raw hop before any node does anything."""
+    hops_in_sequence = {"loop": 3, "one-message": 3, "ring": 3, "ping-pong": 2}
+    cycles: dict[str, list[float]] = {name: [] for name in PATTERNS}
+    ratios: dict[str, list[float]] = {name: [] for name in PATTERNS}
+    for _ in range(repeat):
+        h1 = hop_us()
+        round_ = {name: pattern_cycle_us(3000, name) for name in PATTERNS}
+        hop = (h1 + hop_us()) / 2
+        for name, cycle in round_.items():
+            cycles[name].append(cycle)
+            ratios[name].append(cycle / (hops_in_sequence[name] * hop))
+
+    def median(xs: list[float]) -> float:
+        return statistics.median(xs)
+
+    return "; ".join(
+        f"{name}: cycle median {median(cycles[name]):.0f} us (runs: "
+        f"{', '.join(f'{c:.0f}' for c in cycles[name])}), {median(ratios[name]):.2f}x "
+        f"{hops_in_sequence[name]} hops"
+        for name in PATTERNS
     )
