@@ -305,10 +305,41 @@ def test_realtime_ticks_apply_the_newest_command_and_the_watchdog_zeroes_a_silen
     command(loop, -1.0, stamped=False)
     loop.tick(t + 0.001)
     assert port.sent[-1].effort == (-1.0,) and not loop.watchdog.tripped
-    assert log.said("valid effort_command again: effort resumed") == 1
     stats = loop.stats()
     assert stats.cycles == 8 and stats.commands_on_time == 1 and stats.watchdog_trips == 1
     assert stats.commands_late == 7  # every tick after the first had no stamped command
+    # said at most a line a second: the resumption waits for the second to pass
+    assert log.said("effort resumed") == 0
+    loop.tick(t + 1.0)
+    assert log.said("valid effort_command again: effort resumed (after trip 1)") == 1
+
+
+def test_a_trip_soon_after_another_is_said_late_not_lost() -> None:
+    """A start-up trip (no command yet), then the link is lost within the second: the second
+    trip, with how long its command was held, is said once the second has passed."""
+    loop, _port, log = started(lockstep=False, wait_for=[])
+    t = loop.deadline
+    for _ in range(6):  # no command ever: trips on the sixth sample
+        said_at = t
+        loop.tick(t)
+        t += 0.001
+    assert log.said("watchdog: no valid effort_command for ever") == 1
+    command(loop, 1.0)
+    for _ in range(7):  # resumes, then the command is held 6 samples and the watchdog trips again
+        loop.tick(t)
+        t += 0.001
+    assert loop.watchdog.trips == 2 and len(log.lines) == 1  # within the second: not said yet
+    loop.tick(said_at + 0.999)
+    assert len(log.lines) == 1
+    loop.tick(said_at + 1.0)
+    assert log.lines[1] == (
+        "warning",
+        "watchdog: no valid effort_command for 6 samples (limit 5 ms of simulated time): effort "
+        "zeroed (2 trips so far)",
+    )
+    command(loop, 1.0)
+    loop.shutdown()  # the news of the last moment is said, however soon after the line before
+    assert log.lines[2] == ("info", "valid effort_command again: effort resumed (after trip 2)")
 
 
 def test_realtime_shutdown_runs_one_last_period_at_zero_effort() -> None:

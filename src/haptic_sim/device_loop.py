@@ -32,6 +32,7 @@ from haptic_sim.slide import SimulatedSlide
 
 STARTUP_RESEND_S = 0.5  # lockstep: sample 0 again this often until command 0 comes
 GRAPH_POLL_S = 0.05  # how often the start and the end of a run look at the graph again
+WATCHDOG_SAY_EVERY_S = 1.0  # the watchdog says at most a line this often; news waits, never lost
 
 
 class LoopPort(Protocol):
@@ -94,7 +95,8 @@ class DeviceLoop:
         self.guard = CommandGuard(device.max_effort, self._say_refusing)
         self.configure(self.settings_for(values))
         self.watchdog = CommandWatchdog(self.period_ns, self._say_tripped, self._say_resumed)
-        self._tripped_line = ""  # what the watchdog has to say, once the sample is out
+        self._news: tuple[bool, str] | None = None  # the watchdog's unsaid line (warning?, text)
+        self._say_after = -float("inf")  # monotonic s before which the watchdog says nothing
         self.realtime = RealtimeStats()
         self.recorders = RecorderGate()
         self.zero = [0.0] * device.dof
@@ -124,20 +126,32 @@ class DeviceLoop:
         )
 
     def _say_tripped(self, held: str) -> None:
-        """Said once the tick's sample is out (``tick``)."""
+        """A trip, said once the tick's sample is out (``_say_pending``)."""
         timeout = self.settings.command_timeout_s
-        self._tripped_line = (
+        self._news = (
+            True,
             f"watchdog: no valid {EFFORT_COMMAND} for {held} (limit {timeout * 1e3:g} ms of "
-            f"simulated time): effort zeroed ({self.watchdog.trips} trips so far)"
+            f"simulated time): effort zeroed ({self.watchdog.trips} trips so far)",
         )
 
-    def _say_pending(self) -> None:
-        if self._tripped_line:
-            self.log.warning(self._tripped_line, throttle_duration_sec=1.0)
-            self._tripped_line = ""
-
     def _say_resumed(self) -> None:
-        self.log.info("valid effort_command again: effort resumed", throttle_duration_sec=1.0)
+        """The end of a trip, said after the next tick's sample; a trip not said yet is said
+        with it."""
+        resumed = "valid effort_command again: effort resumed"
+        if self._news is not None and self._news[0]:
+            self._news = (True, f"{self._news[1]}; {resumed}")
+        else:
+            self._news = (False, f"{resumed} (after trip {self.watchdog.trips})")
+
+    def _say_pending(self, now: float) -> None:
+        """Say the watchdog's newest news, at most one line every ``WATCHDOG_SAY_EVERY_S``: a
+        controller that comes and goes does not flood the log, and a trip soon after another
+        (a start-up trip, then a lost link) is said late rather than not at all."""
+        if self._news is not None and now >= self._say_after:
+            warning, line = self._news
+            (self.log.warning if warning else self.log.info)(line)
+            self._news = None
+            self._say_after = now + WATCHDOG_SAY_EVERY_S
 
     # --- inputs ---------------------------------------------------------------------------
     def command(self, cmd: EffortCommand) -> None:
@@ -325,7 +339,7 @@ class DeviceLoop:
             effort = self.zero
         self.advance(effort)
         self.send_sample()
-        self._say_pending()
+        self._say_pending(now)
         self.deadline = self.realtime.next_deadline(self.deadline, now, period)
 
     # --- end ------------------------------------------------------------------------------
@@ -342,3 +356,4 @@ class DeviceLoop:
         if not self.lockstep and self.started:
             self.advance(self.zero)
             self.send_sample()
+        self._say_pending(float("inf"))  # the watchdog's last news, however soon after a line
