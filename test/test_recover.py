@@ -142,17 +142,21 @@ def test_refusals_are_one_line(tmp_path: Path) -> None:
 def test_recorder_killed_at_1khz_loses_at_most_its_last_second(
     tmp_path: Path, storage: str
 ) -> None:
-    """A 1 kHz stream into ``haptic-record``; kill -9 after 3000 samples and 1500 more: every
-    sample up to the 3000th is in the recovered bag, without a gap (the 1500 samples, 1.5 s,
-    cover the recorder's one-second durability interval)."""
+    """A 1 kHz stream into ``haptic-record``; kill -9 once the recorder has written the 3000th
+    sample and then one sent more than its one-second durability interval later (its progress
+    reports say what it wrote): every sample up to the 3000th is in the recovered bag, without a
+    gap. Bounded in what the recorder wrote, not in seconds: a busy machine leaves it behind."""
+    from haptic_dob.bag.cdr import header_stamp_ns
+    from haptic_dob.recorder.recording import DURABLE_EVERY_NS
     from haptic_msgs_py.ros import qos
     from haptic_msgs_py.ros.raw import RawPublisher
+    from haptic_msgs_py.topics import RECORDER_PROGRESS
     from rosgraph import Collector, Process, isolated_env
     from waits import wait_until
 
     env = isolated_env()
     bag = tmp_path / "session"
-    col = Collector(env, {})
+    col = Collector(env, {RECORDER_PROGRESS: "std_msgs/msg/Header"})
     pub = RawPublisher(col.node, JS_TYPE, JOINT_STATES, qos.LOOP)
     rec = Process(
         [tool("haptic-record"), str(bag), "--storage", storage, "--topic", JOINT_STATES],
@@ -161,16 +165,34 @@ def test_recorder_killed_at_1khz_loses_at_most_its_last_second(
     )
     msg = wire.joint_state(["slide"], "base_link")
     msg.velocity, msg.effort = np.zeros(1), np.zeros(1)
+
+    def written_ns() -> int:
+        """The newest stamp the recorder reported written (ns; -1 before any report)."""
+        with col._lock:
+            reports = col.records[RECORDER_PROGRESS]
+            return header_stamp_ns(reports[-1][1]) if reports else -1  # type: ignore[return-value]
+
+    kept = 2999 * PERIOD_NS  # the 3000th sample
+    kept_at = later = None  # when it was written; the first sample sent a durability interval on
     try:
         assert wait_until(lambda: pub.get_subscription_count() >= 1, 60), rec.output()
         start = time.monotonic()
-        for k in range(4500):
+        for k in range(60_000):
             msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(k * PERIOD_NS, 10**9)
             msg.position = np.array([1e-6 * k])
             pub.publish(msg)
+            now = time.monotonic()
+            if kept_at is None and written_ns() >= kept:
+                kept_at = now
+            elif kept_at is not None and later is None and now > kept_at + DURABLE_EVERY_NS * 1e-9:
+                later = k
+            if later is not None and written_ns() >= later * PERIOD_NS:
+                break
             ahead = start + (k + 1) * 1e-3 - time.monotonic()  # paced at 1 kHz
             if ahead > 0:
                 time.sleep(ahead)
+        else:
+            pytest.fail(f"the recorder wrote up to {written_ns()} ns of 60 s sent")
         os.killpg(rec.proc.pid, signal.SIGKILL)
         rec.proc.wait(10)
     finally:
