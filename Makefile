@@ -17,10 +17,10 @@ demo: $(STAMP)
 reproduce: $(STAMP)
 	@$(BIN)/haptic-experiment --out report
 
-# Three phases: the tests that neither talk DDS nor start node processes run on every CPU
-# (pytest-xdist, at most 4 workers); then those that do (marked dds by test/conftest.py), bounded
+# Three phases, by directory: test/unit/ (no DDS, no node processes) on every CPU
+# (pytest-xdist, at most 4 workers); then test/graph/ (marked dds by test/conftest.py), bounded
 # in samples, two at a time (one on one CPU), each on a domain id of its worker's; then the ones
-# whose premise is real time (marked alone) one at a time, alone on the machine, as they ask.
+# whose premise is real time (test/graph/realtime/, marked alone) one at a time, alone.
 # Every phase always runs; the exit code is the worst.
 # CI= : pytest prints whole assertion diffs when CI is set; one failure's diff of a 5000-sample
 # list could then hide every other failure in a truncated log

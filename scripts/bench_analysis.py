@@ -40,8 +40,8 @@ BAGS = {"40s": 1, "1h": 90}  # name -> how many 40 s sessions back to back
 def make_bag(directory: Path, name: str, storage: str) -> Path:
     """Write the named bag (unless it is there already); return its path."""
     from haptic_dob.bag.write import write_session_bag
-    from haptic_dob.control import ControlMode, ImpedanceLaw
-    from haptic_sim.session import SessionConfig, run_session
+    from haptic_dob.core.control import ControlMode, ImpedanceLaw
+    from haptic_sim.slide.session import SessionConfig, run_session
 
     path = directory / f"{name}_{storage}"
     if (path / "metadata.yaml").exists():

@@ -11,8 +11,8 @@ import time
 
 def bench_batch_session(repeat: int) -> str:
     """A 40 s slide session at 1 kHz (default config, OL and DOB): real-time factor."""
-    from haptic_sim.session import SessionConfig, run_session
-    from haptic_sim.stability import law_for
+    from haptic_sim.slide.session import SessionConfig, run_session
+    from haptic_sim.slide.stability import law_for
 
     out = []
     for mode, kf in (("OL", 0.0), ("DOB", 1.0)):
@@ -31,8 +31,8 @@ def bench_observer_update(repeat: int) -> str:
     """One slide observer update (validation, implicit update, clip): microseconds."""
     import timeit
 
-    from haptic_dob.models import SlideModel
-    from haptic_dob.observer import DisturbanceObserver
+    from haptic_dob.core.models import SlideModel
+    from haptic_dob.core.observers.disturbance import DisturbanceObserver
 
     obs = DisturbanceObserver(SlideModel(), 41.6, 1e-3, 4.0)
     q, qd, tau = (0.001,), (0.01,), (0.5,)
@@ -46,8 +46,8 @@ def bench_observer_update(repeat: int) -> str:
 
 def batch_cycle_us(mode: str = "DOB", kf: float = 1.0, seconds: float = 10.0) -> float:
     """One batch slide session's time per cycle (µs): the maths of the loop with no transport."""
-    from haptic_sim.session import SessionConfig, run_session
-    from haptic_sim.stability import law_for
+    from haptic_sim.slide.session import SessionConfig, run_session
+    from haptic_sim.slide.stability import law_for
 
     cfg = SessionConfig().replace(law=law_for(mode, kf), loop__duration_s=seconds)
     t0 = time.perf_counter()

@@ -2,7 +2,7 @@
 
 ``haptic_dob.runtime.ros.dds_hop`` measures it (each side a process with an events executor and
 the loop's QoS); ``hop_us`` is also the floor ``benchmarks.py margin`` compares the 4-process
-graph with, and the real-time tests of that layout check it first (``test/capacity.py``).
+graph with, and the real-time tests of that layout check it first (``test/support/capacity.py``).
 """
 
 from __future__ import annotations

@@ -3,12 +3,12 @@
 
     scripts/haptic_analyze.py BAG [BAG ...] [--json | --csv] [--plot DIR] ...
 
-See ``haptic-analyze --help`` (``haptic_dob.bag.cli``).
+See ``haptic-analyze --help`` (``haptic_dob.cli.analyze``).
 """
 
 import sys
 
-from haptic_dob.bag.cli import main
+from haptic_dob.cli.analyze import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -30,8 +30,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from haptic_dob.core.validation import finite_scalar, nonnegative, positive
 from haptic_dob.runtime.params import param
-from haptic_dob.validation import finite_scalar, nonnegative, positive
 
 BEHAVIOURS = ("semi_random", "push_hold", "none")
 BLOCK_S = 0.1  # s of reference per generated block (numpy, 1000 physics steps at 10 kHz)

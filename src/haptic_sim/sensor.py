@@ -7,8 +7,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from haptic_dob.core.validation import finite_scalar, nonnegative, positive
 from haptic_dob.runtime.params import param
-from haptic_dob.validation import finite_scalar, nonnegative, positive
 
 #: ATI Nano-17-class defaults: ~1/320 N resolution, a few mN of noise, filtered to 500 Hz
 NANO17_NOISE_STD_N = 0.005

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from haptic_dob.validation import positive
+from haptic_dob.core.validation import positive
 
 
 @dataclass(frozen=True)

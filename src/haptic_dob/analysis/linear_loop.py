@@ -28,7 +28,7 @@ import math
 import numpy as np
 from scipy.signal import cont2discrete
 
-from haptic_dob.validation import nonnegative, positive
+from haptic_dob.core.validation import nonnegative, positive
 
 MODES = ("OL", "CL", "DOB")
 #: how far above 1 a spectral radius must be to count as unstable (rounding of a unit eigenvalue)

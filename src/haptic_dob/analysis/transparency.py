@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from haptic_dob.validation import nonnegative, positive
+from haptic_dob.core.validation import nonnegative, positive
 
 BAND_DB = 3.0
 DEFAULT_SEGMENT_S = 2.0

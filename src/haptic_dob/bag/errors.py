@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from haptic_dob.cli import CliError
+from haptic_dob.errors import InputError
 
 
-class BagError(CliError):
+class BagError(InputError):
     """A bag that cannot be analysed as asked (missing, corrupt, wrong topics, too short...).
 
     The message names the bag and the problem in one line; ``haptic-analyze`` prints it as

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from haptic_dob.bag.bagfile import listing, open_bag, resolve_topic, topics_of
 from haptic_dob.bag.errors import BagError
 from haptic_dob.bag.series import JOINT_STATE
-from haptic_dob.identification import JointRecord
+from haptic_dob.identification.one_dof import JointRecord
 
 
 @dataclass(frozen=True)

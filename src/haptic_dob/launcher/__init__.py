@@ -2,12 +2,12 @@
 
 The tool in four parts: ``options`` (what was asked for, checked), ``node_params`` (the nodes'
 parameter table of a launch), ``process_plan`` (which processes run which nodes, with what
-command line) and ``supervise`` (start, watch, forward signals, stop); ``cli`` ties them to the
-command line (``main``). The names below are the ones other code (the launch file, the graph
+command line) and ``supervise`` (start, watch, forward signals, stop); ``haptic_dob.cli.launch``
+ties them to the command line (``main``). The names below are the ones other code (the launch file,
+the graph
 runs, the tests) imports from here.
 """
 
-from haptic_dob.launcher.cli import command, main
 from haptic_dob.launcher.node_params import (
     add_cpu_latency,
     add_pinning,
@@ -28,9 +28,7 @@ __all__ = [
     "add_cpu_latency",
     "add_pinning",
     "add_recorder",
-    "command",
     "groups_for",
-    "main",
     "normalize_namespace",
     "parse_sets",
     "plan",

@@ -2,7 +2,7 @@
 
 import sys
 
-from haptic_dob.launcher.cli import main
+from haptic_dob.cli.launch import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -11,7 +11,7 @@ from typing import Any
 
 import yaml
 
-from haptic_dob.cli import CliError
+from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import NODES
 from haptic_dob.runtime.params import load_node_params
 
@@ -21,7 +21,7 @@ def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, 
     out = load_node_params(config)
     unknown = [n for n in out if n != "/**" and n not in NODES]
     if unknown:
-        raise CliError(
+        raise InputError(
             f"{config} names unknown node(s) {', '.join(unknown)}; known: {', '.join(NODES)}"
         )
     for node, values in sets.items():
@@ -32,7 +32,9 @@ def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, 
 def add_recorder(params: dict[str, Any], output: str, storage: str) -> None:
     """A ``recorder_node`` writing ``output``, and the device waiting for it (loses nothing)."""
     if Path(output).exists():
-        raise CliError(f"--record {output}: it exists already; the recorder never overwrites a bag")
+        raise InputError(
+            f"--record {output}: it exists already; the recorder never overwrites a bag"
+        )
     params.setdefault("recorder_node", {}).update(output=output, storage=storage)
     device = params.setdefault("device_node", {})
     wait = list(device.get("wait_for", ["environment_node", "observer_node", "controller_node"]))
@@ -49,12 +51,12 @@ def add_pinning(params: dict[str, Any]) -> str:
     try:
         assigned = placement([n for n in params if n != "/**"], available_cpus())
     except ValueError as exc:
-        raise CliError(f"--pin: {exc}") from None
+        raise InputError(f"--pin: {exc}") from None
     common = params.get("/**", {}).get("cpu_affinity")
     for name, cpus in assigned.items():
         given = params[name].get("cpu_affinity", common)
         if given is not None and not isinstance(given, list):
-            raise CliError(f"cpu_affinity of {name} must be a list of CPU numbers, got {given!r}")
+            raise InputError(f"cpu_affinity of {name} must be a list of CPU numbers, got {given!r}")
         if given:
             assigned[name] = given
         else:
@@ -69,7 +71,7 @@ def add_cpu_latency(params: dict[str, Any], latency_us: int) -> None:
     from haptic_dob.runtime.cpus import PAIRS
 
     if not 0 <= latency_us <= 1_000_000:
-        raise CliError(f"--cpu-latency {latency_us}: must be 0 to 1000000 us (0: idle CPUs poll)")
+        raise InputError(f"--cpu-latency {latency_us}: must be 0 to 1000000 us (0: idle CPUs poll)")
     common = params.get("/**", {}).get("cpu_latency_us")
     for name in (n for pair in PAIRS for n in pair if n in params):
         if params[name].get("cpu_latency_us", common) in (None, NO_REQUEST):

@@ -10,7 +10,7 @@ from typing import Any
 
 import yaml
 
-from haptic_dob.cli import CliError
+from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import NODES
 
 
@@ -43,13 +43,13 @@ def comma_list(text: str) -> tuple[str, ...]:
 
 
 def normalize_namespace(namespace: str) -> str:
-    """``slide1`` -> ``/slide1`` (ROS wants it absolute); ``CliError`` for an invalid name."""
+    """``slide1`` -> ``/slide1`` (ROS wants it absolute); ``InputError`` for an invalid name."""
     ns = namespace.strip()
     if not ns:
         return ""
     ns = "/" + ns.strip("/")
     if not re.fullmatch(r"(/[A-Za-z_][A-Za-z0-9_]*)+", ns):
-        raise CliError(
+        raise InputError(
             f"--namespace {namespace!r} is not a valid ROS namespace (letters, digits and _ "
             "separated by /, each part not starting with a digit)"
         )
@@ -73,16 +73,16 @@ def parse_sets(items: Sequence[str]) -> dict[str, dict[str, Any]]:
         node, sep, assignment = item.partition(":")
         param, eq, text = assignment.partition("=")
         if not (sep and eq and node and param):
-            raise CliError(f"--set needs NODE:PARAM=VALUE, got {item!r}")
+            raise InputError(f"--set needs NODE:PARAM=VALUE, got {item!r}")
         if node not in NODES:
-            raise CliError(f"--set names unknown node {node!r}; nodes: {', '.join(NODES)}")
+            raise InputError(f"--set names unknown node {node!r}; nodes: {', '.join(NODES)}")
         moved = MOVED.get((node, param))
         if moved:
-            raise CliError(f"--set {node}:{param}: {moved}")
+            raise InputError(f"--set {node}:{param}: {moved}")
         try:
             value = yaml.safe_load(text)
         except yaml.YAMLError:
-            raise CliError(f"--set {item!r}: the value is not valid YAML") from None
+            raise InputError(f"--set {item!r}: the value is not valid YAML") from None
         out.setdefault(node, {})[param] = value
     return out
 
@@ -94,10 +94,10 @@ NETWORKS = {"localhost": "LOCALHOST", "subnet": "SUBNET"}
 def network_env(network: str, peers: Sequence[str]) -> dict[str, str]:
     """The discovery variables for ``--network`` and ``--peers``."""
     if network not in NETWORKS:
-        raise CliError(f"--network must be one of {', '.join(NETWORKS)}, got {network!r}")
+        raise InputError(f"--network must be one of {', '.join(NETWORKS)}, got {network!r}")
     env = {"ROS_AUTOMATIC_DISCOVERY_RANGE": NETWORKS[network]}
     if peers:
         if network == "localhost":
-            raise CliError("--peers needs --network subnet (peers are other hosts)")
+            raise InputError("--peers needs --network subnet (peers are other hosts)")
         env["ROS_STATIC_PEERS"] = ";".join(peers)
     return env

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from haptic_dob.cli import CliError
+from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import CONTAINER, LOOP_NODES, NODES, START_ORDER
 
 
@@ -41,9 +41,9 @@ def executable(package: str, name: str) -> str:
     try:
         path = Path(get_package_prefix(package)) / "lib" / package / name
     except PackageNotFoundError:
-        raise CliError(f"package {package} is not in the ament index; reinstall") from None
+        raise InputError(f"package {package} is not in the ament index; reinstall") from None
     if not os.access(path, os.X_OK):
-        raise CliError(f"{path} is missing or not executable; reinstall")
+        raise InputError(f"{path} is missing or not executable; reinstall")
     return str(path)
 
 
@@ -54,7 +54,7 @@ def select(names: Sequence[str], only: Sequence[str]) -> list[str]:
         return list(names)
     unknown = [n for n in only if n not in names]
     if unknown:
-        raise CliError(
+        raise InputError(
             f"--only names {', '.join(unknown)}, which the config does not start "
             f"(it starts {', '.join(sorted(names))})"
         )
@@ -67,7 +67,7 @@ def groups_for(
     """Which of ``names`` share a process: ``--composed`` all, ``--processes`` none,
     ``--group A,B`` (repeatable) the named ones, by default the loop's nodes."""
     if sum((composed, processes, bool(given))) > 1:
-        raise CliError("--composed, --processes and --group are different choices: pick one")
+        raise InputError("--composed, --processes and --group are different choices: pick one")
     if processes:
         return []
     if composed:
@@ -79,20 +79,20 @@ def groups_for(
         group = [n for n in text.split(",") if n]
         unknown = [n for n in group if n not in NODES]
         if unknown:
-            raise CliError(f"--group names unknown node(s) {', '.join(unknown)}")
+            raise InputError(f"--group names unknown node(s) {', '.join(unknown)}")
         twice = [n for n in group if n in seen]
         if twice or len(set(group)) != len(group):
-            raise CliError(f"--group: {', '.join(twice or group)} named in more than one place")
+            raise InputError(f"--group: {', '.join(twice or group)} named in more than one place")
         seen.update(group)
         groups.append([n for n in group if n in names])
     return groups
 
 
 def check_pinnable(groups: Sequence[Sequence[str]]) -> None:
-    """``--pin`` places node processes on CPUs: ``CliError`` when nodes share a process."""
+    """``--pin`` places node processes on CPUs: ``InputError`` when nodes share a process."""
     shared = [g for g in groups if len(g) > 1]
     if shared:
-        raise CliError(
+        raise InputError(
             f"--pin places node processes on CPUs, and {', '.join(shared[0])} share one "
             "(the loop is composed by default): add --processes"
         )
@@ -108,7 +108,7 @@ def plan(
     nodes and arguments; nodes of one group share a process (the container)."""
     names = [n for n in START_ORDER if n in params]
     if not names:
-        raise CliError("the config starts no nodes")
+        raise InputError("the config starts no nodes")
     ros = ["--ros-args", "--params-file", str(params_file)]
     if namespace:
         ros += ["-r", f"__ns:={namespace}"]

@@ -11,7 +11,7 @@ import subprocess
 import sys
 import time
 
-from haptic_dob.cli import CliError
+from haptic_dob.errors import InputError
 from haptic_dob.launcher.process_plan import ProcessSpec
 
 RT_PRIORITIES = range(1, 100)  # SCHED_FIFO priorities Linux accepts
@@ -20,16 +20,16 @@ RT_PRIORITIES = range(1, 100)  # SCHED_FIFO priorities Linux accepts
 def set_rt_priority(priority: int) -> None:
     """Run this process (and the processes and threads it starts) with ``SCHED_FIFO``.
 
-    Raises ``CliError`` with the reason when the system does not allow it.
+    Raises ``InputError`` with the reason when the system does not allow it.
     """
     if priority not in RT_PRIORITIES:
-        raise CliError(f"--rt-priority {priority}: must be 1 to 99 (SCHED_FIFO priorities)")
+        raise InputError(f"--rt-priority {priority}: must be 1 to 99 (SCHED_FIFO priorities)")
     if not hasattr(os, "sched_setscheduler"):
-        raise CliError("--rt-priority: this system has no SCHED_FIFO scheduling (Linux only)")
+        raise InputError("--rt-priority: this system has no SCHED_FIFO scheduling (Linux only)")
     try:
         os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
     except PermissionError as exc:
-        raise CliError(
+        raise InputError(
             f"--rt-priority {priority}: not permitted ({exc.strerror}); it needs root, "
             "CAP_SYS_NICE, or an rtprio limit (limits.conf) of at least that priority"
         ) from None
@@ -37,13 +37,13 @@ def set_rt_priority(priority: int) -> None:
 
 def check_cpu_latency_request(latency_us: int) -> None:
     """Make the request once and withdraw it: a launch that cannot make it stops before any
-    node starts, with the reason (``CliError``)."""
+    node starts, with the reason (``InputError``)."""
     from haptic_dob.runtime.cpu_latency import hold
 
     try:
         os.close(hold(latency_us))
     except ValueError as exc:
-        raise CliError(f"--cpu-latency {latency_us}: {exc}") from None
+        raise InputError(f"--cpu-latency {latency_us}: {exc}") from None
 
 
 def launch(

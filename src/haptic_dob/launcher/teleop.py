@@ -26,7 +26,7 @@ from typing import Any
 
 import yaml
 
-from haptic_dob.cli import CliError
+from haptic_dob.errors import InputError
 from haptic_dob.launcher.options import LaunchOptions, network_env
 from haptic_dob.launcher.process_plan import ProcessSpec, executable
 from haptic_dob.launcher.supervise import launch, set_rt_priority
@@ -51,7 +51,7 @@ def teleop_params(
     try:
         check_sections(sections)
     except ValueError as exc:
-        raise CliError(str(exc)) from None
+        raise InputError(str(exc)) from None
     out = {f"{ns}/{node}": node_values(sections, ns, node) for ns, node in graph_nodes()}
     for item in sets:
         target, sep, assignment = item.partition(":")
@@ -60,14 +60,14 @@ def teleop_params(
         names = [f"{n}/{node}" for n in NAMESPACES] if ns == "**" else [target]
         names = [n for n in names if n in out]
         if not (sep and eq and param and names):
-            raise CliError(
+            raise InputError(
                 f"--set needs NS/NODE:PARAM=VALUE with a node of the graph ({', '.join(out)}; "
                 f"**/NODE for both sides), got {item!r}"
             )
         try:
             value = yaml.safe_load(text)
         except yaml.YAMLError:
-            raise CliError(f"--set {item!r}: the value is not valid YAML") from None
+            raise InputError(f"--set {item!r}: the value is not valid YAML") from None
         for name in names:
             out[name][param] = value
     for ns in NAMESPACES:  # a real-time side's channel end uses what has come (no lockstep wait)
@@ -94,7 +94,9 @@ def write_teleop_params(params: Mapping[str, Mapping[str, Any]], directory: Path
 def add_teleop_recorder(params: dict[str, dict[str, Any]], output: str, storage: str) -> None:
     """``--record``: a recorder of both sides (``RECORDER``), and both devices waiting for it."""
     if Path(output).exists():
-        raise CliError(f"--record {output}: it exists already; the recorder never overwrites a bag")
+        raise InputError(
+            f"--record {output}: it exists already; the recorder never overwrites a bag"
+        )
     params[RECORDER.lstrip("/")] = {
         "output": output,
         "storage": storage,
@@ -109,12 +111,12 @@ def add_teleop_recorder(params: dict[str, dict[str, Any]], output: str, storage:
 
 
 def _expand(item: str, names: Sequence[str], flag: str) -> list[str]:
-    """A side (``master``, ``slave``) -> its nodes; ``NS/NODE`` -> itself; ``CliError`` else."""
+    """A side (``master``, ``slave``) -> its nodes; ``NS/NODE`` -> itself; ``InputError`` else."""
     if item in NAMESPACES:
         return [n for n in names if n.startswith(f"{item}/")]
     if item in names:
         return [item]
-    raise CliError(
+    raise InputError(
         f"{flag} names {item!r}: give a side (master, slave) or a node of the graph "
         f"({', '.join(names)})"
     )
@@ -134,7 +136,7 @@ def teleop_groups(
     """Which nodes share a process: ``--processes`` none, ``--group`` (``master``, ``slave`` or
     ``NS/NODE`` items) the named ones, else (``--composed``, the default) all."""
     if sum((composed, processes, bool(given))) > 1:
-        raise CliError("--composed, --processes and --group are different choices: pick one")
+        raise InputError("--composed, --processes and --group are different choices: pick one")
     if processes:
         return []
     if not given:
@@ -145,7 +147,7 @@ def teleop_groups(
         group = [n for item in text.split(",") if item for n in _expand(item, names, "--group")]
         twice = sorted({n for n in group if n in seen or group.count(n) > 1})
         if twice:
-            raise CliError(f"--group: {', '.join(twice)} named in more than one place")
+            raise InputError(f"--group: {', '.join(twice)} named in more than one place")
         seen.update(group)
         groups.append(group)
     return groups
@@ -184,10 +186,10 @@ REFUSED = {
 
 
 def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]]) -> int:
-    """Plan and run a teleoperation graph; ``CliError`` on bad input."""
+    """Plan and run a teleoperation graph; ``InputError`` on bad input."""
     given = [flag for field, flag in REFUSED.items() if getattr(opts, field)]
     if given:
-        raise CliError(
+        raise InputError(
             f"{', '.join(given)}: not for a teleoperation graph (its namespaces are "
             "/master and /slave)"
         )
@@ -195,7 +197,7 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
     names = select_nodes([n for n in params if "/" in n], opts.only)
     groups = teleop_groups(names, opts.composed, opts.processes, opts.groups)
     if opts.record and opts.only:
-        raise CliError(
+        raise InputError(
             "--record with --only: both sides' devices wait for the recorder, so record where "
             "the whole graph starts (or run haptic-record and add it to each device's wait_for)"
         )

@@ -22,8 +22,8 @@ from typing import Any
 
 from rclpy.context import Context
 
-from haptic_dob.models.factory import build_model, model_specs
-from haptic_dob.models.slide import SlideModel
+from haptic_dob.core.models.factory import build_model, model_specs
+from haptic_dob.core.models.slide import SlideModel
 from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report

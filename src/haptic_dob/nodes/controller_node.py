@@ -30,10 +30,10 @@ from typing import Any
 
 from rclpy.context import Context
 
-from haptic_dob.command_join import FALLBACKS, CommandJoin
-from haptic_dob.control import ImpedanceController, ImpedanceLaw
-from haptic_dob.joint_states import JointMap, pick
-from haptic_dob.models.factory import build_model, model_specs
+from haptic_dob.core.command_join import FALLBACKS, CommandJoin
+from haptic_dob.core.control import ImpedanceController, ImpedanceLaw
+from haptic_dob.core.joint_states import JointMap, pick
+from haptic_dob.core.models.factory import build_model, model_specs
 from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
@@ -95,7 +95,7 @@ def controller_node_specs() -> list[ParamSpec]:
 
 
 class ControllerNode(LoopNode):
-    """Computes command k from the stamp-k inputs its mode needs (``haptic_dob.command_join``)."""
+    """Computes command k from the stamp-k inputs its mode needs (``core.command_join``)."""
 
     def __init__(
         self,

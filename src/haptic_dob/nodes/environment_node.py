@@ -13,9 +13,9 @@ from typing import Any, NamedTuple
 
 from rclpy.context import Context
 
-from haptic_dob.cycle import wall_force
-from haptic_dob.environment import VirtualWall
-from haptic_dob.excitation import Excitation
+from haptic_dob.core.cycle import wall_force
+from haptic_dob.core.environment import VirtualWall
+from haptic_dob.core.excitation import Excitation
 from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report

@@ -15,13 +15,14 @@ from typing import Any
 from rclpy.context import Context
 from std_srvs.srv import Trigger
 
-from haptic_dob.control import ZERO_FORCE, Force
-from haptic_dob.cycle import estimate
-from haptic_dob.joint_states import JointMap, joint_vectors
-from haptic_dob.models.base import DeviceModel
-from haptic_dob.models.factory import build_model, model_specs
+from haptic_dob.core.control import ZERO_FORCE, Force
+from haptic_dob.core.cycle import estimate
+from haptic_dob.core.joint_states import JointMap, joint_vectors
+from haptic_dob.core.models.base import DeviceModel
+from haptic_dob.core.models.factory import build_model, model_specs
+from haptic_dob.core.observers.disturbance import DisturbanceObserver
+from haptic_dob.core.observers.factory import ObserverSettings
 from haptic_dob.nodes.common import loop_specs, main_for, process_specs
-from haptic_dob.observer import DisturbanceObserver, ObserverSettings
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import ERROR, OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable

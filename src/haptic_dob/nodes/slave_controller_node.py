@@ -16,8 +16,8 @@ import sys
 import numpy as np
 from rclpy.context import Context
 
-from haptic_dob.joint_states import JointMap, pick
-from haptic_dob.models.factory import build_model, model_specs
+from haptic_dob.core.joint_states import JointMap, pick
+from haptic_dob.core.models.factory import build_model, model_specs
 from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report

@@ -7,5 +7,5 @@ passivity control.
 - ``ends``: the master's and the slave's end of the channel (what each side computes per cycle);
 - ``slave``: the slave arm's joint impedance tracking a Cartesian point (differential IK).
 
-The batch runner (``haptic_sim.teleop_session``) and the nodes run the same classes.
+The batch runner (``haptic_sim.teleop.session``) and the nodes run the same classes.
 """

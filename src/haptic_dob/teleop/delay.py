@@ -9,7 +9,7 @@ batch run and a node graph that hand over the same messages see the same channel
 In lockstep a receiver must have been handed every message that can be due by ``k`` (those of
 samples up to ``k - delay``) before it takes: ``complete(k)``.
 
-The watchdog (``haptic_dob.watchdog``) counts the samples since the newest arrival: the peer is
+The watchdog (``haptic_dob.core.watchdog``) counts the samples since the newest arrival: the peer is
 lost when nothing arrived for more than ``timeout_s`` of sample time.
 """
 
@@ -20,8 +20,8 @@ import random
 from collections.abc import Callable
 from typing import Generic, TypeVar
 
+from haptic_dob.core.watchdog import CommandWatchdog
 from haptic_dob.teleop.settings import ChannelSettings
-from haptic_dob.watchdog import CommandWatchdog
 
 M = TypeVar("M")
 

@@ -27,7 +27,7 @@ import math
 from collections.abc import Callable
 from typing import NamedTuple
 
-from haptic_dob.control import ZERO_FORCE, Force, limit_norm
+from haptic_dob.core.control import ZERO_FORCE, Force, limit_norm
 from haptic_dob.teleop.delay import DelayLine, _quiet
 from haptic_dob.teleop.passivity import PassivityPort
 from haptic_dob.teleop.settings import ChannelSettings, TeleopSettings

@@ -7,7 +7,7 @@ parameters are those sections overlaid from the general to the specific: ``/**``
 ``/**/<node>``, ``/<ns>/<node>``. The nodes: on both sides ``device_node``, ``observer_node`` and
 the channel's end ``channel_node``; the master's ``controller_node`` (the haptic law rendering the
 channel's force) and the slave's ``slave_controller_node`` (the joint impedance). The batch runner
-(``haptic_sim.teleop_config``) and ``haptic-launch`` read a file the same way.
+(``haptic_sim.teleop.config``) and ``haptic-launch`` read a file the same way.
 """
 
 from __future__ import annotations

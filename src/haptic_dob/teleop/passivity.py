@@ -20,7 +20,7 @@ Values are 3-vectors of floats (slave units: N, m/s); nothing here allocates arr
 
 from __future__ import annotations
 
-from haptic_dob.control import Force
+from haptic_dob.core.control import Force
 
 
 class PassivityPort:

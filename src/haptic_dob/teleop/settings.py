@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from haptic_dob.core.validation import nonnegative, positive
 from haptic_dob.runtime.params import param
-from haptic_dob.validation import nonnegative, positive
 
 ARCHITECTURES = ("position_force", "position_position")
 FORCE_SOURCES = ("estimate", "sensor")

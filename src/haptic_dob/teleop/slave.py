@@ -8,7 +8,7 @@ Per cycle, with the joint state of sample k and the point ``x_d`` to track (m, b
    toward the start posture ``q_0`` in the null space; ``dq`` is limited to
    ``max_joint_speed_rad_s`` per period;
 2. ``tau = K (q_d - q) - B q' + G(q)`` (gravity of the controller's model), saturated per joint
-   at the model's effort limits (``haptic_dob.control.saturate``).
+   at the model's effort limits (``haptic_dob.core.control.saturate``).
 
 The gains are matrices shaped by the inertia at the start pose: ``K = D(q_0) w^2``,
 ``B = 2 zeta w D(q_0)`` with ``w = 2 pi bandwidth_hz``, so every mode of the arm (not only
@@ -27,10 +27,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from haptic_dob.control import saturate
-from haptic_dob.models.base import DeviceModel, Vec
+from haptic_dob.core.control import saturate
+from haptic_dob.core.models.base import DeviceModel, Vec
+from haptic_dob.core.validation import nonnegative, positive
 from haptic_dob.runtime.params import param
-from haptic_dob.validation import nonnegative, positive
 
 
 @dataclass(frozen=True)

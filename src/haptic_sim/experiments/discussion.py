@@ -7,7 +7,7 @@ the parts that were run (``parts.EXPERIMENTS``).
 from __future__ import annotations
 
 from haptic_sim.experiments import thesis
-from haptic_sim.experiments.dob import GRIPS, DobStudy, first_vibrating_with
+from haptic_sim.experiments.dob_mechanism import GRIPS, DobStudy, first_vibrating_with
 from haptic_sim.experiments.phantom import PhantomResult
 from haptic_sim.experiments.records import RunAnalysis
 from haptic_sim.experiments.results import bound

@@ -10,12 +10,12 @@ from typing import Any
 import numpy as np
 
 from haptic_sim.experiments import thesis
-from haptic_sim.experiments.dob import KickPoint
+from haptic_sim.experiments.dob_mechanism import KickPoint
 from haptic_sim.experiments.records import GraphOnset, RunAnalysis, label
 from haptic_sim.experiments.results import bound, ch7_grid
-from haptic_sim.experiments.zwidth import K_MAX, K_MIN, MapPoint
-from haptic_sim.session import SessionResult
-from haptic_sim.stability import VIBRATION_RMS_M
+from haptic_sim.experiments.stability_map import K_MAX, K_MIN, MapPoint
+from haptic_sim.slide.session import SessionResult
+from haptic_sim.slide.stability import VIBRATION_RMS_M
 
 
 def pyplot() -> Any:

@@ -17,21 +17,21 @@ from pathlib import Path
 from typing import Any, Generic, TypeVar
 
 from haptic_sim.experiments import (
-    ch4,
-    ch4_report,
-    ch5,
-    ch5_report,
     discussion,
-    dob,
+    dob_mechanism,
     figures,
+    identification,
+    identification_report,
+    observer_vs_sensor,
+    observer_vs_sensor_report,
     phantom,
     plan,
     results,
     spread,
+    stability_map,
     sweeps,
     sweeps_report,
     tables,
-    zwidth,
 )
 from haptic_sim.experiments.graph_runs import GraphRun
 from haptic_sim.experiments.jsonio import from_json, to_json
@@ -42,7 +42,7 @@ from haptic_sim.experiments.records import (
     ExperimentResults,
     RunAnalysis,
 )
-from haptic_sim.session import SessionConfig
+from haptic_sim.slide.session import SessionConfig
 
 R = TypeVar("R")
 
@@ -117,39 +117,43 @@ def _b_rate(base: SessionConfig) -> tuple[float, float]:
 
 def _kick_traces(base: SessionConfig, path: Path) -> None:
     """The stick-or-chatter traces: simulated and drawn while the dob part runs."""
-    wall = dob.TRACES_WALL
-    figures.plot_kick_traces(dob.traces(base, wall), wall, path)
+    wall = dob_mechanism.TRACES_WALL
+    figures.plot_kick_traces(dob_mechanism.traces(base, wall), wall, path)
 
 
-CH4: Experiment[ch4.Ch4Result] = Experiment(
+CH4: Experiment[identification.Ch4Result] = Experiment(
     part="ch4",
-    result_type=ch4.Ch4Result,
-    job=GraphJob(ch4.chapter4_runs, ch4.ch4_result, analyse=False),
+    result_type=identification.Ch4Result,
+    job=GraphJob(identification.chapter4_runs, identification.ch4_result, analyse=False),
     heading="Chapter 4: identification and model verification through the node graph",
     intro="The graph holds the simulated slide in an 80 N/m two-sided virtual spring (OL, no "
     "hand) while the environment adds a known force: the thesis's 2.4 N step to identify the "
     "model, 1.6 N and 3.2 N steps and a 0.6 N, 2 Hz sine to verify it. Each run is a bag; "
     "`haptic-identify`'s core reads the joint states of the 2.4 N bag.",
-    body=lambda r, base: [ch4_report.ch4_tables(r, base)],
+    body=lambda r, base: [identification_report.ch4_tables(r, base)],
     figures=(
-        Figure("ch4_identification.png", "thesis figure 4.2", ch4_report.plot_identification),
-        Figure("ch4_verification.png", "thesis figure 4.3", ch4_report.plot_verification),
+        Figure(
+            "ch4_identification.png", "thesis figure 4.2", identification_report.plot_identification
+        ),
+        Figure(
+            "ch4_verification.png", "thesis figure 4.3", identification_report.plot_verification
+        ),
     ),
-    notes=lambda r: [ch4_report.ch4_notes(r)],
+    notes=lambda r: [identification_report.ch4_notes(r)],
     checks=lambda r: r.checks,
-    console=ch4_report.ch4_console,
+    console=identification_report.ch4_console,
 )
-CH5: Experiment[ch5.Ch5Result] = Experiment(
+CH5: Experiment[observer_vs_sensor.Ch5Result] = Experiment(
     part="ch5",
-    result_type=ch5.Ch5Result,
-    job=GraphJob(ch5.chapter5_runs, ch5.ch5_result, analyse=False),
+    result_type=observer_vs_sensor.Ch5Result,
+    job=GraphJob(observer_vs_sensor.chapter5_runs, observer_vs_sensor.ch5_result, analyse=False),
     heading="Thesis section 5.3: the observer against the force sensor",
     intro="The observer runs beside an OL loop (the model it assumes, its output clipped to "
     "4 N as the thesis clipped it) while the semi-random hand moves the slide in free space, "
     "then pushes into an 800 N/m wall; each session is a bag.",
-    body=lambda r, base: [ch5_report.ch5_table(r, base)],
-    figures=(Figure("ch5_observer.png", "thesis section 5.3", ch5_report.plot_ch5),),
-    console=ch5_report.ch5_console,
+    body=lambda r, base: [observer_vs_sensor_report.ch5_table(r, base)],
+    figures=(Figure("ch5_observer.png", "thesis section 5.3", observer_vs_sensor_report.plot_ch5),),
+    console=observer_vs_sensor_report.ch5_console,
 )
 CH7: Experiment[Ch7Result] = Experiment(
     part="ch7",
@@ -200,11 +204,11 @@ CH6: Experiment[Ch6Result] = Experiment(
     ],
     console=lambda r: tables.ch6_console(r.onsets, r.taps),
 )
-MAP: Experiment[zwidth.StabilityMap] = Experiment(
+MAP: Experiment[stability_map.StabilityMap] = Experiment(
     part="map",
-    result_type=zwidth.StabilityMap,
+    result_type=stability_map.StabilityMap,
     job=BatchJob(
-        lambda base, pool, _figs: zwidth.map_study(base, pool),
+        lambda base, pool, _figs: stability_map.map_study(base, pool),
         lambda r: f"stability map: {len(r.points)} onsets",
     ),
     heading="Stability map (batch)",
@@ -222,11 +226,11 @@ MAP: Experiment[zwidth.StabilityMap] = Experiment(
         Figure("zwidth.png", "Z-width", lambda r, path, _base: figures.plot_zwidth(r.points, path)),
     ),
 )
-DOB: Experiment[dob.DobStudy] = Experiment(
+DOB: Experiment[dob_mechanism.DobStudy] = Experiment(
     part="dob",
-    result_type=dob.DobStudy,
+    result_type=dob_mechanism.DobStudy,
     job=BatchJob(
-        lambda base, pool, _figs: dob.study(base, pool),
+        lambda base, pool, _figs: dob_mechanism.study(base, pool),
         lambda _r: "DOB mechanism study: done",
     ),
     heading="The DOB question: quiet at Kf = 100 up to 2400 N/m",

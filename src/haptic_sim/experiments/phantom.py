@@ -1,6 +1,6 @@
 """Thesis section 5.2 on the PHANToM 1.5 as a part of the experiment: the numbers of its report.
 
-The reproductions are ``haptic_sim.thesis52``'s (``haptic-phantom-figures``); they draw
+The reproductions are ``haptic_sim.phantom.reproduction``'s (``haptic-phantom-figures``); they draw
 ``thesis_5_2_1.png`` and ``thesis_5_2_2.png`` while they run.
 """
 
@@ -31,7 +31,7 @@ class PhantomResult:
 
 def reproduce(figures: Path) -> PhantomResult:
     """Run 5.2.1 and 5.2.2 (their figures go to ``figures``)."""
-    from haptic_sim.thesis52 import KF_VALUES, reproduce_free_motion, reproduce_wall
+    from haptic_sim.phantom.reproduction import KF_VALUES, reproduce_free_motion, reproduce_wall
 
     free = reproduce_free_motion(figures)
     wall = reproduce_wall(figures)

@@ -9,8 +9,8 @@ The quick variant (the demo) runs OL, CL Kf = 2 and DOB Kf = 1 at 800 N/m for 20
 
 Chapter 6 (vibration onset, through the graph), the thesis's user trying to provoke vibration:
 a light 20 N/m grip pushing 1 N into the wall, 4-4.5 s per wall, in two protocols of
-``haptic_sim.stability``. The linear one (a 0.5 N x 5 ms pulse, Coulomb friction off in the plant
-and in the model: the premise of the passivity bounds the thesis compares its OL and CL onsets
+``haptic_sim.slide.stability``. The linear one (a 0.5 N x 5 ms pulse, Coulomb friction off in the
+plant and in the model: the premise of the passivity bounds the thesis compares its OL and CL onsets
 with) for OL and CL with Kf = 2 over the thesis's walls plus points that bracket their bounds, and
 DOB with Kf = 100 at two walls (linearly unstable at every wall). The tap (``TAP``: the
 configuration's plant and model as they are, a 3 N x 20 ms tap) for all three: OL and CL at
@@ -26,7 +26,7 @@ from haptic_sim.experiments import thesis
 from haptic_sim.experiments.graph_runs import GraphRun, session_params
 from haptic_sim.experiments.records import Cell, label
 from haptic_sim.hand import reference_for_force
-from haptic_sim.stability import TAP, StabilityProtocol
+from haptic_sim.slide.stability import TAP, StabilityProtocol
 
 CH7_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0), ("DOB", 25.0)]
 CH7_WALLS: list[float] = list(thesis.WALLS)

@@ -15,7 +15,7 @@ from typing import Any
 from haptic_sim.experiments.parts import Experiment, present
 from haptic_sim.experiments.records import ExperimentResults
 from haptic_sim.experiments.tables import config_table
-from haptic_sim.session import SessionConfig
+from haptic_sim.slide.session import SessionConfig
 
 
 def section(e: Experiment[Any], result: Any, base: SessionConfig, figures: Path) -> list[str]:

@@ -5,7 +5,7 @@
 be regenerated from the bags by the analysis alone. The chapter-7 tables take the transparency of
 each run; the chapter-6 onsets take each linear-protocol run's pulse response
 (``perturbation_growth_per_s``) and interpolate its zero crossing along the walls
-(``haptic_sim.stability.onset``), as the batch sweep does; its tap runs are read for their
+(``haptic_sim.slide.stability.onset``), as the batch sweep does; its tap runs are read for their
 residual motion (``ch6tap``).
 """
 
@@ -18,7 +18,6 @@ from typing import Any
 
 from haptic_dob.analysis.linear_loop import linear_onset
 from haptic_sim.experiments import thesis
-from haptic_sim.experiments.ch6tap import tap_checks, tap_result
 from haptic_sim.experiments.graph_runs import GraphRun, bag_path, run_dir
 from haptic_sim.experiments.plan import CH6_PARTS, CH7_CONTROLLERS, CH7_WALLS
 from haptic_sim.experiments.records import (
@@ -30,8 +29,9 @@ from haptic_sim.experiments.records import (
     RunAnalysis,
     label,
 )
-from haptic_sim.session import SessionConfig
-from haptic_sim.stability import StabilityPoint, StabilityProtocol, onset
+from haptic_sim.experiments.tap import tap_checks, tap_result
+from haptic_sim.slide.session import SessionConfig
+from haptic_sim.slide.stability import StabilityPoint, StabilityProtocol, onset
 
 #: a chapter-7 cell: (mode, Kf, wall in N/m)
 CellKey = tuple[str, float, float]

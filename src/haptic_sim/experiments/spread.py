@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from haptic_sim.experiments import thesis
 from haptic_sim.experiments.tables import fmt
 from haptic_sim.hand import reference_for_force
-from haptic_sim.session import SessionConfig, run_session
-from haptic_sim.stability import law_for
+from haptic_sim.slide.session import SessionConfig, run_session
+from haptic_sim.slide.stability import law_for
 
 SEEDS = (0, 1)
 DURATION_S = 40.0  # chapter 7's sessions

@@ -35,9 +35,9 @@ from haptic_dob.analysis.transparency import transparency
 from haptic_sim.experiments import spread, thesis
 from haptic_sim.experiments.tables import fmt
 from haptic_sim.hand import reference_for_force
-from haptic_sim.session import SessionConfig, run_session
-from haptic_sim.stability import law_for
-from haptic_sim.stability import sweep as stability_sweep
+from haptic_sim.slide.session import SessionConfig, run_session
+from haptic_sim.slide.stability import law_for
+from haptic_sim.slide.stability import sweep as stability_sweep
 
 SETTLE_S = 2.0  # the hand's ramp-in, left out as the sessions' summaries leave it out
 SEED = 0  # the hand's seed: chapter 7's default

@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 from haptic_dob.analysis.linear_loop import chatter_gain
 from haptic_sim.experiments import thesis
-from haptic_sim.experiments.dob import (
+from haptic_sim.experiments.dob_mechanism import (
     GRIPS,
     WALLS,
     DobStudy,
@@ -24,9 +24,9 @@ from haptic_sim.experiments.records import (
     label,
 )
 from haptic_sim.experiments.results import bound, ch7_grid
-from haptic_sim.experiments.zwidth import MapPoint
-from haptic_sim.session import SessionConfig
-from haptic_sim.stability import VIBRATION_RMS_M
+from haptic_sim.experiments.stability_map import MapPoint
+from haptic_sim.slide.session import SessionConfig
+from haptic_sim.slide.stability import VIBRATION_RMS_M
 
 
 def fmt(v: float | None, spec: str = ".2f", none: str = "–") -> str:

@@ -56,16 +56,16 @@ from haptic_msgs_py.topics import (
     WRENCH_MEASURED,
 )
 from haptic_msgs_py.values import JointSample, Stamp, StampedVector
-from haptic_sim.cycle_stats import CycleStats
-from haptic_sim.device import DeviceSample
-from haptic_sim.device_loop import DeviceLoop
-from haptic_sim.device_settings import (
+from haptic_sim.device.cycle_stats import CycleStats
+from haptic_sim.device.factory import build_device
+from haptic_sim.device.loop import DeviceLoop
+from haptic_sim.device.sample import DeviceSample
+from haptic_sim.device.settings import (
     DeviceLoopSettings,
     device_node_specs,
     missing_nodes,
     start_topics,
 )
-from haptic_sim.factory import build_device
 
 
 class DeviceNode(LoopNode):

@@ -22,7 +22,7 @@ from launch.event_handlers import OnShutdown
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
-from haptic_dob.configs import resolve_config
+from haptic_dob.runtime.configs import resolve_config
 from haptic_dob.launcher import NODES, START_ORDER, groups_for, resolved_params, write_params_file
 from haptic_dob.nodes.registry import CONTAINER
 

@@ -3,7 +3,7 @@
 What DDS and rclpy alone cost a message between two processes on this machine, now (the
 process wake-ups on each side included): the floor the 4-process loop is measured against in
 the benchmarks (``scripts/bench_margin.py``), and part of the premise the real-time tests of
-that layout check before they ask for 1 kHz (``test/capacity.py``). Each side is a process
+that layout check before they ask for 1 kHz (``test/support/capacity.py``). Each side is a process
 with an events executor and the loop's QoS, on the domain id it is given, localhost only.
 """
 

@@ -1,0 +1,201 @@
+"""``haptic-identify BAG``: the 1-DOF device model (mass, viscous and Coulomb friction) from a bag.
+
+Reads the joint states of a recorded session (MCAP or sqlite3; ours or ``ros2 bag record``'s;
+``/joint_states`` alone is enough) and identifies ``m x'' + c x' + Fc sgn(x') = u`` by least
+squares (default) or by the step method under a virtual spring (``--method step``, or
+``thesis_step`` for the thesis's formulas verbatim).
+With ``--urdf FILE --tip-frame F`` it identifies an arm's joint friction instead (viscous and
+Coulomb per joint, beyond the URDF's rigid body; ``haptic_dob.identification.arm_friction``), judged
+on held-out data. Prints a table, or one JSON line (``--json``); ``--write-yaml FILE`` writes the
+model as a params file (``slide.*``, or ``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``,
+of the observer and the controller, the nodes that assume a model) to load after the session's
+config.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from haptic_dob.cli.common import ArgumentParser, run
+from haptic_dob.errors import InputError
+from haptic_dob.identification.arm_friction import ArmFrictionFit
+from haptic_dob.identification.filters import plus_minus
+from haptic_dob.identification.one_dof import METHODS, IdentificationError, SlideFit
+
+
+@dataclass(frozen=True)
+class ArmSpec:
+    """The arm whose friction is identified: URDF file, tip frame, joints (empty: the chain)."""
+
+    urdf: str
+    tip_frame: str
+    joints: tuple[str, ...] = ()
+    turn_cutoff_hz: float | None = None  # the search for v_c through this low-pass (Hz)
+
+
+#: why a fit has no Coulomb friction: the step method separates it from the swings' decay only
+#: where the effort holds the rendered spring (it then falls back to the thesis's formulas)
+NO_COULOMB = {
+    "step": "- (the effort holds no spring: the thesis's formulas, friction read as damping)",
+    "thesis_step": "- (the thesis's formulas leave it out)",
+}
+
+
+def table(fit: SlideFit, bag: str) -> str:
+    """The fit as a short table (units in the row names)."""
+    no_fc = NO_COULOMB.get(fit.method, "-")
+    rows = [
+        f"bag {bag}, joint {fit.joint}, method {fit.method}, {fit.samples} samples",
+        f"mass_kg              {plus_minus(fit.mass_kg, fit.mass_std, '.4f')}",
+        f"viscous_n_s_per_m    {plus_minus(fit.viscous_n_s_per_m, fit.viscous_std, '.4f')}",
+        f"coulomb_n            {plus_minus(fit.coulomb_n, fit.coulomb_std, '.4f', no_fc)}",
+    ]
+    if fit.rms_residual_n is not None:
+        rows.append(f"rms residual (N)     {fit.rms_residual_n:.4f}")
+    return "\n".join(rows)
+
+
+#: the nodes that assume a model of the device (the device node keeps its own physics)
+MODEL_NODES = ("observer_node", "controller_node")
+
+
+def model_yaml(params: Mapping[str, object], what: str, bag: str) -> str:
+    """A params file that sets ``params`` of the observer's and the controller's model."""
+    import yaml
+
+    head = f"# identified from {bag} by haptic-identify ({what})\n"
+    doc = {f"/**/{n}": {"ros__parameters": dict(params)} for n in MODEL_NODES}
+    body: str = yaml.safe_dump(doc, sort_keys=False)
+    return head + body
+
+
+def arm_table(fit: ArmFrictionFit, bag: str) -> str:
+    """Each joint's friction and what it explains on the held-out part of the record."""
+    held = round(100 * fit.holdout)
+    rows = [
+        f"bag {bag}: joint friction beyond the URDF's rigid body (held out: the last {held} %)",
+        "joint                viscous (N m s/rad)   Coulomb (N m)       turns over (rad/s)  "
+        "held-out RMS (N m): rigid -> with friction",
+    ]
+    for j in fit.joints:
+        turn = f"{j.coulomb_speed:.4g}" if j.coulomb_speed > 0.0 else "- (a sign)"
+        rows.append(
+            f"{j.joint:<20} {plus_minus(j.viscous, j.viscous_std, '.4f'):<21} "
+            f"{plus_minus(j.coulomb, j.coulomb_std, '.4f'):<19} {turn:<19} "
+            f"{j.heldout_rms_rigid:.4f} -> {j.heldout_rms:.4f}"
+        )
+    return "\n".join(rows)
+
+
+def arm_command(bag: str, topic: str, arm: ArmSpec, as_json: bool, write_yaml: str | None) -> int:
+    """Identify an arm's joint friction, print it, optionally write it as the model's."""
+    from haptic_dob.bag.joints import read_joints
+    from haptic_dob.core.models import UrdfModel
+    from haptic_dob.identification.arm_friction import identify_arm_friction
+
+    rigid = UrdfModel(arm.urdf, arm.tip_frame, arm.joints or None, viscous=0.0, coulomb=0.0)
+    js = read_joints(bag, topic, rigid.joint_names)
+    try:
+        fit = identify_arm_friction(
+            rigid,
+            js.stamps_ns,
+            js.position,
+            js.effort,
+            js.names,
+            turn_cutoff_hz=arm.turn_cutoff_hz,
+        )
+    except IdentificationError as exc:
+        raise InputError(f"{bag}: {exc}") from None
+    if as_json:
+        print(json.dumps({"bag": bag, "joints": [j.__dict__ for j in fit.joints]}))
+    else:
+        print(arm_table(fit, bag))
+    if write_yaml:
+        text = model_yaml(fit.as_params(), f"joint friction, URDF {arm.urdf}", bag)
+        Path(write_yaml).write_text(text, encoding="utf-8")
+        if not as_json:
+            print(f"model written to {write_yaml}")
+    return 0
+
+
+def command(
+    bag: str, topic: str, joint: str | None, method: str, as_json: bool, write_yaml: str | None
+) -> int:
+    """Identify, print, optionally write the model; errors raise (``run`` reports them)."""
+    from haptic_dob.bag.joints import read_joint
+    from haptic_dob.identification.one_dof import identify
+
+    rec = read_joint(bag, topic, joint)
+    try:
+        fit = identify(rec, method)
+    except IdentificationError as exc:
+        raise InputError(f"{bag}: {exc}") from None
+    if as_json:
+        out = {k: v for k, v in fit.__dict__.items()}
+        out["bag"] = bag
+        print(json.dumps(out))
+    else:
+        print(table(fit, bag))
+    if write_yaml:
+        what = f"{fit.method}, joint {fit.joint}"
+        Path(write_yaml).write_text(model_yaml(fit.as_params(), what, bag), encoding="utf-8")
+        if not as_json:
+            print(f"model written to {write_yaml}")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Parse the command line and run."""
+    p = ArgumentParser(prog="haptic-identify", description=__doc__.split("\n\n")[0])
+    p.add_argument("bag", help="bag directory, .mcap or .db3 file")
+    p.add_argument(
+        "--topic", default="joint_states", help="JointState topic (default joint_states)"
+    )
+    p.add_argument("--joint", help="joint name (default: the first)")
+    p.add_argument(
+        "--method",
+        choices=METHODS,
+        default="least_squares",
+        help="least_squares (any excitation, default); step (under a rendered spring: damping "
+        "and Coulomb friction from the swings' decay); thesis_step (the thesis's formulas: "
+        "the first overshoot, no Coulomb friction)",
+    )
+    p.add_argument("--json", action="store_true", help="one JSON line instead of the table")
+    p.add_argument("--write-yaml", metavar="FILE", help="write the model as a params file")
+    p.add_argument(
+        "--urdf", metavar="FILE", help="an arm: identify its joint friction beyond this URDF"
+    )
+    p.add_argument("--tip-frame", help="with --urdf: the arm's end-effector frame")
+    p.add_argument(
+        "--joints",
+        help="with --urdf: comma-separated joints (default: the chain to the tip); the chain's "
+        "other joints are taken as still at zero",
+    )
+    p.add_argument(
+        "--turn-cutoff-hz",
+        type=float,
+        metavar="HZ",
+        help="with --urdf: judge the speed the Coulomb friction turns over through this "
+        "low-pass (default: the fit's 20 Hz); a wider one (e.g. 50) resolves a turn of a few "
+        "milliseconds where the encoders resolve speeds well below it",
+    )
+    a = p.parse_args(argv)
+    if a.turn_cutoff_hz is not None and not 0.0 < a.turn_cutoff_hz < float("inf"):
+        p.error(f"--turn-cutoff-hz must be a positive number of Hz, got {a.turn_cutoff_hz:g}")
+    if a.urdf:
+        if not a.tip_frame:
+            p.error("--urdf needs --tip-frame")
+        joints = tuple(j for j in (a.joints or "").split(",") if j)
+        arm = ArmSpec(a.urdf, a.tip_frame, joints, a.turn_cutoff_hz)
+        return run(lambda: arm_command(a.bag, a.topic, arm, a.json, a.write_yaml))
+    if a.turn_cutoff_hz is not None:
+        p.error("--turn-cutoff-hz needs --urdf")
+    return run(lambda: command(a.bag, a.topic, a.joint, a.method, a.json, a.write_yaml))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

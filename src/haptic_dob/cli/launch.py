@@ -1,0 +1,217 @@
+"""``haptic-launch``: bring up a session's node graph from one ``ros__parameters`` YAML.
+
+Every node section of the YAML (``device_node``, ``environment_node``, ``observer_node``,
+``controller_node``, ``recorder_node``) starts through the ``ros2 run`` contract
+(``<prefix>/lib/<pkg>/<exe>`` found with ``ament_index_python``), with
+``--ros-args --params-file CONFIG`` and the namespace. Composition groups say which nodes share a
+process (``<prefix>/lib/haptic_dob/container``, where the loop's messages are handed over in
+process): by default the loop (device, environment, observer, controller) shares one and a
+recorder runs apart; ``--processes`` gives every node its own, ``--composed`` puts all in one,
+``--group`` names groups. The device's process starts last. Ctrl-C or SIGTERM is forwarded to
+every process as SIGTERM (each shuts down cleanly: the device zeroes its effort; a node still
+starting up ends quietly, with no Python traceback as SIGINT would give) and the launcher waits
+for them, killing what is still alive after ``--stop-timeout``. When the device finishes a
+lockstep run (``duration_s``) the others are stopped too.
+
+Network: by default every node's discovery stays on this host
+(``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), so a simulated session never reaches a lab network
+by accident. ``--network subnet`` lets them discover across the subnet, ``--peers`` adds named
+hosts (``ROS_STATIC_PEERS``), and ``--only`` starts a subset: the device on one host and the rest
+on another (see docs/running.md, "Lab network and security").
+
+A teleoperation YAML (``/master/...`` and ``/slave/...`` sections) starts the two sides' nodes in
+their namespaces, all in one process by default; ``--group`` and ``--only`` take sides there
+(``haptic_dob.launcher.teleop``).
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+from haptic_dob.cli.common import ArgumentParser, run
+from haptic_dob.launcher.node_params import (
+    add_cpu_latency,
+    add_pinning,
+    add_recorder,
+    resolved_params,
+    write_params_file,
+)
+from haptic_dob.launcher.options import (
+    NETWORKS,
+    LaunchOptions,
+    comma_list,
+    network_env,
+    normalize_namespace,
+    parse_sets,
+)
+from haptic_dob.launcher.process_plan import check_pinnable, groups_for, plan, select
+from haptic_dob.launcher.supervise import check_cpu_latency_request, launch, set_rt_priority
+from haptic_dob.launcher.teleop import teleop_command
+from haptic_dob.nodes.registry import START_ORDER
+from haptic_dob.runtime.configs import resolve_config
+from haptic_dob.runtime.params import load_sections
+from haptic_dob.teleop.graph import is_teleop, load_teleop_sections
+
+
+def command(opts: LaunchOptions) -> int:
+    """Resolve, plan and run; raises ``InputError`` on bad input."""
+    path = resolve_config(opts.config)
+    sections = load_sections(path)
+    if is_teleop(sections):
+        return teleop_command(opts, load_teleop_sections(path))
+    namespace = normalize_namespace(opts.namespace)
+    params = resolved_params(path, parse_sets(opts.sets))
+    if opts.record:
+        add_recorder(params, opts.record, opts.record_storage)
+    names = select([n for n in START_ORDER if n in params], opts.only)
+    groups = groups_for(names, opts.composed, opts.processes, opts.groups)
+    if opts.pin:
+        check_pinnable(groups)
+        print(f"haptic-launch: CPUs {add_pinning(params)}", file=sys.stderr)
+    if opts.cpu_latency_us is not None:
+        add_cpu_latency(params, opts.cpu_latency_us)
+        check_cpu_latency_request(opts.cpu_latency_us)
+    net = network_env(opts.network, opts.peers)
+    if opts.rt_priority is not None:  # the nodes started below inherit the policy
+        set_rt_priority(opts.rt_priority)
+    if opts.executor:
+        net["HAPTIC_DOB_EXECUTOR"] = opts.executor
+    with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
+        chosen = {n: v for n, v in params.items() if n == "/**" or n in names}
+        specs = plan(chosen, write_params_file(params, Path(tmp)), namespace, groups)
+        for spec in specs:
+            if len(spec.nodes) > 1:
+                print(f"haptic-launch: {', '.join(spec.nodes)} in one process", file=sys.stderr)
+        return launch(specs, opts.stop_timeout, opts.duration, net)
+
+
+def build_parser() -> ArgumentParser:
+    """The command line of ``haptic-launch``."""
+    p = ArgumentParser(prog="haptic-launch", description=__doc__.split("\n\n")[0])
+    p.add_argument("config", help="session YAML (a path, or an installed name like slide_sim)")
+    p.add_argument("--namespace", default="", help="namespace of every node (one device per ns)")
+    p.add_argument(
+        "--composed", action="store_true", help="run every node in one process (one executor)"
+    )
+    p.add_argument(
+        "--processes",
+        action="store_true",
+        help="run every node in a process of its own (default: the loop's four nodes share one, "
+        "their messages handed over in process; a recorder runs apart)",
+    )
+    p.add_argument(
+        "--group",
+        action="append",
+        default=[],
+        metavar="NODE,NODE[,...]",
+        help="these nodes share a process (repeatable; nodes in no group run alone; for a "
+        "teleoperation graph: master, slave or NS/NODE)",
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NODE:PARAM=VALUE",
+        help="override a parameter of one node (repeatable)",
+    )
+    p.add_argument(
+        "--duration",
+        type=float,
+        metavar="S",
+        help="stop the graph after this many wall-clock seconds",
+    )
+    p.add_argument(
+        "--stop-timeout",
+        type=float,
+        default=5.0,
+        metavar="S",
+        help="how long nodes get to stop cleanly before they are killed (default 5)",
+    )
+    p.add_argument(
+        "--executor",
+        choices=["events", "single"],
+        help="rclpy executor of the nodes (default events)",
+    )
+    p.add_argument(
+        "--only",
+        default="",
+        metavar="NODE[,NODE...]",
+        help="start only these nodes of the config (split a session across hosts; for a "
+        "teleoperation graph: master, slave or NS/NODE)",
+    )
+    p.add_argument(
+        "--network",
+        choices=sorted(NETWORKS),
+        default="localhost",
+        help="discovery range of the nodes: localhost (default) or subnet (a lab network)",
+    )
+    p.add_argument(
+        "--peers",
+        default="",
+        metavar="HOST[,HOST...]",
+        help="other hosts to discover directly (ROS_STATIC_PEERS; needs --network subnet)",
+    )
+    p.add_argument(
+        "--record",
+        metavar="BAG",
+        help="record the session into this new bag (a recorder_node the device waits for)",
+    )
+    p.add_argument(
+        "--record-storage", choices=["mcap", "sqlite3"], default="mcap", help="default mcap"
+    )
+    p.add_argument(
+        "--rt-priority",
+        type=int,
+        metavar="P",
+        help="run the nodes with real-time scheduling, SCHED_FIFO priority P (1-99; Linux, needs "
+        "root or CAP_SYS_NICE): fewer late commands in real time (BENCHMARKS.md)",
+    )
+    p.add_argument(
+        "--pin",
+        action="store_true",
+        help="pin each loop node's process to a CPU (its cpu_affinity): device and controller "
+        "on one, environment and observer on another (one each with 4+ CPUs); faster lockstep, "
+        "fewer late commands on an otherwise idle machine (BENCHMARKS.md)",
+    )
+    p.add_argument(
+        "--cpu-latency",
+        type=int,
+        metavar="US",
+        help="while the nodes run, CPUs use only idle states whose advertised exit latency is at "
+        "most US microseconds (their cpu_latency_us; Linux PM QoS, needs root): 0 makes idle CPUs "
+        "poll, which speeds up every hand-over (BENCHMARKS.md) and costs power; on a virtual "
+        "machine only 0 helps",
+    )
+    return p
+
+
+def parse_options(argv: list[str] | None = None) -> LaunchOptions:
+    """``argv`` (``sys.argv[1:]`` when None) as options; bad arguments exit 2 (argparse)."""
+    a = build_parser().parse_args(argv)
+    return LaunchOptions(
+        config=a.config,
+        namespace=a.namespace,
+        sets=tuple(a.set),
+        composed=a.composed,
+        processes=a.processes,
+        groups=tuple(a.group),
+        stop_timeout=a.stop_timeout,
+        duration=a.duration,
+        executor=a.executor,
+        only=comma_list(a.only),
+        network=a.network,
+        peers=comma_list(a.peers),
+        record=a.record,
+        record_storage=a.record_storage,
+        rt_priority=a.rt_priority,
+        pin=a.pin,
+        cpu_latency_us=a.cpu_latency,
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``haptic-launch``."""
+    opts = parse_options(argv)
+    return run(lambda: command(opts))

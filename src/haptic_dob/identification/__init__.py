@@ -1,0 +1,3 @@
+"""Identification of device models from records: the 1-DOF fit, an arm's friction, the filters they
+share.
+"""

@@ -1,0 +1,35 @@
+"""Find the configuration files the project installs under ``share/haptic_dob/config``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from haptic_dob.errors import InputError
+
+
+def config_dir() -> Path:
+    """The installed config directory (``<prefix>/share/haptic_dob/config``)."""
+    from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
+
+    from haptic_msgs_py.ament import ensure_ament_prefix
+
+    ensure_ament_prefix()
+    try:
+        return Path(get_package_share_directory("haptic_dob")) / "config"
+    except PackageNotFoundError:  # pragma: no cover - only without an install
+        return Path(__file__).resolve().parents[2] / "config"
+
+
+def resolve_config(name_or_path: str | Path) -> Path:
+    """A path that exists, or the installed config of that name (``slide_sim`` or ``.yaml``)."""
+    p = Path(name_or_path)
+    if p.is_file():
+        return p
+    name = p.name if p.suffix in (".yaml", ".yml") else f"{p.name}.yaml"
+    candidate = config_dir() / name
+    if candidate.is_file():
+        return candidate
+    if p.exists():
+        raise InputError(f"{p} is not a file")
+    available = ", ".join(sorted(f.stem for f in config_dir().glob("*.yaml")))
+    raise InputError(f"no config {str(name_or_path)!r}; a path or one of: {available}")

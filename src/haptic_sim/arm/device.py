@@ -1,0 +1,347 @@
+"""A simulated multi-DOF arm (the PHANToM 1.5, any URDF arm): plant, encoders, sensor and hand.
+
+Plant: any ``DeviceModel``, ``D(q) q'' + C(q, q') q' + G(q) + friction(q') = tau + J^T F_tip``,
+with ``F_tip`` the hand's force plus an optional known external force at the end-effector point.
+
+Integration: ``substeps`` classical Runge-Kutta (RK4) steps per control period (10 at 1 kHz:
+10 kHz), with the actuator effort held over the whole period (zero-order hold), and the hand's
+reference and the external force held over each sub-step. The dynamics come from the model
+(``haptic_sim.arm.dynamics``: one pass for pinocchio models) and a linear solve. A torque-free,
+frictionless run of the PHANToM keeps its energy to 9e-13 J over 2 s (kinetic energy up to
+0.65 J; test_phantom).
+
+Joint friction: the model's, its Coulomb sign smoothed to ``Fc tanh(q' / eps)`` (RK4 cannot
+integrate a sign; ``arm_dynamics.coulomb_smoothing`` gives eps): slower, a joint creeps.
+
+Actuators: each joint's effort is saturated on its own. The limits are ``joint_effort_limits``
+when given, else the model's own (a URDF's ``<limit effort>``) when it has them for every joint,
+else ``max_force_n`` times each column norm of J at the start pose (at least 1 cm): the joint
+effort that gives ``max_force_n`` at the tip there (``haptic_sim.arm.params`` gives the defaults).
+
+Encoders: joint angles quantized to ``encoder_resolution_rad`` (0 = ideal); velocity is the
+backward difference of the encoder readings, as a driver computes it.
+
+Hand (3-D, ``haptic_sim.hand``): a mass ``m_h`` moving with the handle, held by a grip spring and
+damper to a reference ``x_r(t) = p0 + u r(t) + e1 r1(t) + e2 r2(t)``: ``p0`` the start position of
+the end effector, ``u`` the push direction (``hand_direction``), ``r(t)`` the 1-D reference of
+``hand.py`` (push-and-hold or semi-random, with its ramp and force pulse along ``u``) and ``r1``,
+``r2`` semi-random motions across ``u`` (``hand_lateral_amplitude_m``, default 0). Force on the
+device ``F_h = k_h (x_r - p) + b_h (x_r' - p') + f_ff u - m_h p''``; the hand mass enters the
+dynamics exactly (``D + m_h J^T J``, bias ``+ m_h J^T J' q'``). ``behaviour: none``: no hand.
+
+Contact (``contact``, ``haptic_sim.arm.contact``): a wall the end effector touches, its force
+evaluated at every integration stage from the stage's tip point and velocity and added to the
+external force; ``contact_force_true`` is its value at the sample's true state, and the sample's
+``hand_force`` then carries the external force at that state (a teleoperation slave's true contact).
+
+Force sensor: three ``ForceSensor`` axes (noise, first-order bandwidth, bias) at the handle,
+reading the total external force on the end effector (hand, external force and contact).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any, cast
+
+import numpy as np
+
+from haptic_dob.core.environment import VirtualWall
+from haptic_dob.core.models.base import DeviceModel, Vec
+from haptic_dob.core.validation import positive, unit_vector, vector
+from haptic_msgs_py.stamps import period_ns
+from haptic_sim.arm.contact import contact_of
+from haptic_sim.arm.dynamics import coulomb_smoothing, dynamics_and_tip, mass_and_bias, solve
+from haptic_sim.arm.params import ArmDeviceParams
+from haptic_sim.device.sample import DeviceSample
+from haptic_sim.hand import HandParams, HandReference
+from haptic_sim.sensor import ForceSensor, ForceSensorParams
+
+_ZERO3 = np.zeros(3)
+_NO_J = np.zeros((3, 0))  # the Jacobian slot of ``_last`` on the ABA path (unused there)
+
+
+def _perpendiculars(u: Vec) -> tuple[Vec, Vec]:
+    """Two unit vectors completing ``u`` to a right-handed orthonormal basis."""
+    a = np.array([1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = np.cross(u, a)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(u, e1)
+
+
+class SimulatedArm:
+    """Plant + encoders + force sensor + 3-D hand for any ``DeviceModel`` (cycle contract).
+
+    Args:
+        model: the arm's true physics (gravity included unless the model leaves it out).
+        device: actuators, encoders, start, hand direction, external force.
+        sensor: force-sensor settings (each of the three axes).
+        hand: hand settings (``hand.py``); default ``behaviour='none'``.
+        rate_hz: control rate (Hz), > 0.
+        substeps: RK4 steps per control period, >= 1.
+        seed: seed of the hand's reference and the sensor noise.
+        contact: a wall the end effector touches (None, or zero stiffness: none).
+    """
+
+    def __init__(
+        self,
+        model: DeviceModel,
+        device: ArmDeviceParams | None = None,
+        sensor: ForceSensorParams | None = None,
+        hand: HandParams | None = None,
+        rate_hz: float = 1000.0,
+        substeps: int = 10,
+        seed: int = 0,
+        contact: VirtualWall | None = None,
+    ) -> None:
+        if not isinstance(model, DeviceModel):
+            raise ValueError(f"model must be a DeviceModel, got {type(model).__name__}")
+        self.model = model
+        self.dof = model.dof
+        self.device = device or ArmDeviceParams()
+        self.sensor_params = sensor or ForceSensorParams()
+        self.hand = hand or HandParams(behaviour="none")
+        self.rate_hz = positive("rate_hz", rate_hz)
+        if int(substeps) != substeps or substeps < 1:
+            raise ValueError(f"substeps must be an integer >= 1, got {substeps!r}")
+        self.substeps = int(substeps)
+        self.period_ns = period_ns(self.rate_hz)
+        self.dt = self.period_ns * 1e-9
+        self.dt_physics = self.dt / self.substeps
+        n = self.dof
+        dev = self.device
+        if dev.initial_position:
+            q0 = vector("initial_position", list(dev.initial_position), n)
+        else:
+            q0 = np.array(getattr(model, "home", np.zeros(n)), dtype=np.float64)
+        self._dyn = mass_and_bias(model)
+        self._dyn_tip = dynamics_and_tip(model)
+        # pinocchio's ABA where the model has it (no mass matrix, no solve): the free arm and an
+        # arm under tip forces (contact, an external force), not one with a hand's mass on it
+        self._aba = bool(getattr(model, "_has_forward_dynamics", False))
+        if self._aba:
+            self._fd = cast(Any, model)._forward_dynamics
+            self._tip_motion = cast(Any, model)._tip_motion
+        self._viscous = np.asarray(getattr(model, "viscous", np.zeros(self.dof)), dtype=np.float64)
+        self._coulomb, self._coulomb_eps = coulomb_smoothing(model, self._dyn, q0, self.dt_physics)
+        self.effort_limits = self._limits(q0)
+        #: actuator saturation per joint (N m or N), the ``SimulatedDevice`` protocol's name
+        self.max_effort = tuple(self.effort_limits.tolist())
+        self._lim = self.effort_limits
+        self._neg_lim = -self.effort_limits
+        # hand and external force
+        self._u = unit_vector("hand_direction", dev.hand_direction)
+        self._e1, self._e2 = _perpendiculars(self._u)
+        self._f_ext = vector("external_force_n", dev.external_force_n, 3)
+        self._ext_on_step = (
+            math.ceil(dev.external_force_at_s / self.dt_physics - 1e-9)
+            if np.any(self._f_ext != 0.0)
+            else None
+        )
+        seeds = np.random.SeedSequence(seed).spawn(6)
+        rngs = [np.random.default_rng(s) for s in seeds]
+        h = self.hand
+        self._ref: list[tuple[HandReference, Vec]] = []
+        if h.active:
+            self._ref.append((HandReference(h, self.dt_physics, rngs[0]), self._u))
+            if dev.hand_lateral_amplitude_m > 0.0:
+                lateral = replace(
+                    h,
+                    behaviour="semi_random",
+                    offset_m=0.0,
+                    amplitude_m=dev.hand_lateral_amplitude_m,
+                    perturbation_n=0.0,
+                )
+                for rng, e in ((rngs[1], self._e1), (rngs[2], self._e2)):
+                    self._ref.append((HandReference(lateral, self.dt_physics, rng), e))
+        self._sensors = [ForceSensor(self.sensor_params, self.dt_physics, r) for r in rngs[3:]]
+        self.contact = contact_of(contact)
+        self._contact = None if self.contact is None else self.contact.force
+        self._needs_tip = h.active or self._ext_on_step is not None or self.contact is not None
+        self._kh, self._bh = h.stiffness_n_per_m, h.damping_n_s_per_m
+        self._mh = h.mass_kg if h.active else 0.0
+        self._exact_velocity = dev.velocity == "exact"
+        # state
+        self._k = 0
+        self._i_phys = 0
+        self.q = q0.copy()
+        self.v = np.zeros(n)
+        self.accel = np.zeros(n)
+        self.p0 = model._forward_kinematics(self.q)
+        self.hand_force_true = np.zeros(3)  # the hand's force on the handle (N)
+        self.tip_force_true = np.zeros(3)  # hand + external force + contact on the tip (N)
+        self.contact_force_true = np.zeros(3)  # the contact's force at the sample's state (N)
+        self._effort_applied = np.zeros(n)
+        self._q_enc = self._encode(self.q)
+        self._q_enc_prev = self._q_enc
+        self._sample = self._make_sample()
+
+    # --- protocol --------------------------------------------------------------------------
+    @property
+    def k(self) -> int:
+        """Index of the current sample."""
+        return self._k
+
+    def sample(self) -> DeviceSample:
+        """The current sample k."""
+        return self._sample
+
+    def prepare(self) -> None:
+        """Do ahead the work the next ``apply`` would otherwise do first (the hand's next block)."""
+        for ref, _ in self._ref:
+            ref.prepare(self._i_phys + self.substeps - 1)
+
+    def apply(self, effort: list[float] | tuple[float, ...]) -> None:
+        """Hold ``effort`` (saturated per joint) over [k, k+1) and step to k+1.
+
+        Wrong-length or non-finite efforts raise ``ValueError`` and change nothing.
+        """
+        if len(effort) != self.dof:
+            raise ValueError(f"effort must have length {self.dof}, got {len(effort)}")
+        u = np.array(effort, dtype=np.float64)
+        if u.ndim != 1 or not math.isfinite(u @ u):
+            raise ValueError(f"effort must be finite, got {list(effort)!r}")
+        u = np.minimum(np.maximum(u, self._neg_lim), self._lim)
+        self._integrate(u)
+        if self.contact is not None:  # the contact at the sample's true state, for evaluation
+            c = self.contact.force_at(self.model, self.q, self.v)
+            on = self._ext_on_step is not None and self._i_phys > self._ext_on_step
+            self.tip_force_true = self.hand_force_true + c + (self._f_ext if on else _ZERO3)
+            self.contact_force_true = c
+        self._effort_applied = u
+        self._k += 1
+        self._q_enc_prev = self._q_enc
+        self._q_enc = self._encode(self.q)
+        self._sample = self._make_sample()
+
+    # --- physics ---------------------------------------------------------------------------
+    def _limits(self, q0: Vec) -> Vec:
+        dev, n = self.device, self.dof
+        if dev.joint_effort_limits:
+            return vector("joint_effort_limits", list(dev.joint_effort_limits), n)
+        own = getattr(self.model, "effort_limits", None)
+        if own is not None and len(own) == n and all(v > 0.0 for v in own):
+            return np.array(own, dtype=np.float64)
+        J = self.model._jacobian(q0)
+        return cast(Vec, dev.max_force_n * np.maximum(np.linalg.norm(J, axis=0), 0.01))
+
+    def _accel(self, q: Vec, v: Vec, tau: Vec, f_ext: Vec, ref: tuple[Vec, Vec, Vec] | None) -> Vec:
+        """Joint acceleration; with tip forces also records (grip, J, J' q', f_ext) in ``_last``."""
+        if self._aba and ref is None:  # b q' + Fc tanh(q' / eps) in one go, then ABA
+            if self._coulomb is not None:
+                tau = tau - self._viscous * v - self._coulomb * np.tanh(v / self._coulomb_eps)
+            else:
+                tau = tau - self._viscous * v
+            if not self._needs_tip:
+                a: Vec = self._fd(q, v, tau, None)
+                return a
+            if self._contact is not None:
+                f_ext = f_ext + self._contact(*self._tip_motion(q, v))
+            self._last = (_ZERO3, _NO_J, _ZERO3, f_ext)  # J unused without a hand's grip
+            a = self._fd(q, v, tau, f_ext)
+            return a
+        if self._coulomb is not None:  # the model's Fc sgn(q') -> Fc tanh(q' / eps)
+            fc = self._coulomb
+            tau = tau - fc * (np.tanh(v / self._coulomb_eps) - np.sign(v))
+        if not self._needs_tip:
+            D, h = self._dyn(q, v)
+            return solve(D, tau - h)
+        D, h, p, J, jdv = self._dyn_tip(q, v)
+        if self._contact is not None:
+            f_ext = f_ext + self._contact(p, J @ v)
+        Jt = J.T
+        if ref is None:
+            self._last = (_ZERO3, J, jdv, f_ext)
+            return solve(D, tau - h + Jt @ f_ext)
+        # grip = k_h (x_r - p) + b_h (x_r' - J q') + f_ff, with ref[0] = k_h x_r + b_h x_r' + f_ff
+        grip = ref[0] - self._kh * p - self._bh * (J @ v)
+        self._last = (grip, J, jdv, f_ext)
+        if self._mh > 0.0:
+            return solve(D + self._mh * (Jt @ J), tau - h + Jt @ (grip + f_ext - self._mh * jdv))
+        return solve(D, tau - h + Jt @ (grip + f_ext))
+
+    def _reference(self) -> tuple[Vec, Vec, Vec] | None:
+        """Hand reference at the current physics step: position, velocity, feed-forward force."""
+        if not self._ref:
+            return None
+        x_r, v_r, f_ff = self.p0.copy(), np.zeros(3), np.zeros(3)
+        for ref, e in self._ref:
+            x, xd, ff, j = ref.arrays(self._i_phys)
+            x_r += x[j] * e
+            v_r += xd[j] * e
+            if ff[j] != 0.0:
+                f_ff += ff[j] * e
+        # the damper's reference velocity, the spring's anchor and the pulse, combined once
+        return self._kh * x_r + self._bh * v_r + f_ff, x_r, v_r
+
+    def _integrate(self, tau: Vec) -> None:
+        hstep = self.dt_physics
+        half = 0.5 * hstep
+        q, v = self.q, self.v
+        a1 = self.accel
+        for _ in range(self.substeps):
+            ref = self._reference()
+            f_ext = (
+                self._f_ext
+                if self._ext_on_step is not None and self._i_phys >= self._ext_on_step
+                else _ZERO3
+            )
+            a1 = self._accel(q, v, tau, f_ext, ref)
+            if self._needs_tip:
+                grip, J, jdv, external = self._last
+                hand = grip - self._mh * (J @ a1 + jdv) if ref is not None else grip
+                total = hand + external
+                for s, f in zip(self._sensors, total.tolist(), strict=True):
+                    s.track(f)
+                self.hand_force_true, self.tip_force_true = hand, total
+            v2 = v + half * a1
+            a2 = self._accel(q + half * v, v2, tau, f_ext, ref)
+            v3 = v + half * a2
+            a3 = self._accel(q + half * v2, v3, tau, f_ext, ref)
+            v4 = v + hstep * a3
+            a4 = self._accel(q + hstep * v3, v4, tau, f_ext, ref)
+            q = q + (hstep / 6.0) * (v + 2.0 * (v2 + v3) + v4)
+            v = v + (hstep / 6.0) * (a1 + 2.0 * (a2 + a3) + a4)
+            self._i_phys += 1
+        self.q, self.v, self.accel = q, v, a1
+
+    # --- sensing ---------------------------------------------------------------------------
+    def _encode(self, q: Vec) -> Vec:
+        res = self.device.encoder_resolution_rad
+        if res <= 0.0:
+            return q.copy()
+        return np.round(q / res) * res
+
+    def _make_sample(self) -> DeviceSample:
+        q = self._q_enc
+        qd = self.v.copy() if self._exact_velocity else (q - self._q_enc_prev) / self.dt
+        m = self.model
+        p = m._forward_kinematics(q)
+        pv = m._jacobian(q) @ qd
+        fm = tuple(s.read() for s in self._sensors)
+        fh = self.tip_force_true
+        return DeviceSample(
+            k=self._k,
+            stamp_ns=self._k * self.period_ns,
+            q=tuple(q.tolist()),
+            qd=tuple(qd.tolist()),
+            effort=tuple(self._effort_applied.tolist()),
+            ee_position=(float(p[0]), float(p[1]), float(p[2])),
+            ee_velocity=(float(pv[0]), float(pv[1]), float(pv[2])),
+            wrench_measured=(fm[0], fm[1], fm[2]),
+            hand_force=(float(fh[0]), float(fh[1]), float(fh[2])),
+        )
+
+    # --- evaluation ------------------------------------------------------------------------
+    @property
+    def time_s(self) -> float:
+        """Simulated time of the current sample (s)."""
+        return self._k * self.dt
+
+    def kinetic_energy(self) -> float:
+        """``q'^T D q' / 2`` (J) of the arm's true state (the hand's mass not included)."""
+        D, _ = self._dyn(self.q, self.v)
+        return 0.5 * float(self.v @ D @ self.v)
+
+
+__all__ = ["ArmDeviceParams", "SimulatedArm"]

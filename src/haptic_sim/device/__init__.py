@@ -1,0 +1,3 @@
+"""What a simulated device gives the loop, and the device node's ROS-free loop: settings, timing,
+statistics.
+"""

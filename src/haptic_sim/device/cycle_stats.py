@@ -1,0 +1,82 @@
+"""Real-time cycle statistics of a device: commands on time or late, latency, missed ticks.
+
+Command k is on time when it arrives before the tick that applies it (the plant still at sample
+k); its latency is measured from sample k's send. A tick whose command did not come is late
+(counted once the loop has closed, after the first command). A loop that fell behind by more than
+a period resynchronises and counts the ticks it missed. ``CycleStats`` is what a run reports (the
+``stats_file`` JSON, ``dataclasses.asdict``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from haptic_sim.device.latency import LatencyHistogram
+
+
+@dataclass(frozen=True)
+class CycleStats:
+    """Real-time cycle statistics of a run so far (the ``stats_file`` keys, in order)."""
+
+    cycles: int  # samples the plant moved
+    commands_on_time: int
+    commands_late: int
+    on_time_pct: float  # % of on-time and late commands; NaN before the first
+    missed_ticks: int
+    latency_p50_ms: float  # sample k sent -> command k arrived, ms (NaN before the first)
+    latency_p99_ms: float
+    refused_commands: int
+    limited_commands: int
+    watchdog_trips: int
+
+
+class RealtimeStats:
+    """Counts of a real-time loop, in constant memory however long it runs."""
+
+    def __init__(self) -> None:
+        self.on_time = 0
+        self.late = 0
+        self.missed_ticks = 0
+        self.latency = LatencyHistogram()  # s
+        self._command_k = -1  # the newest sample k whose command came on time
+
+    def command(self, k: int, latency_s: float) -> bool:
+        """Command k came while the plant is at sample k, ``latency_s`` (s) after sample k was
+        sent: counted on time once per k; True when it is the first for k."""
+        if k == self._command_k:
+            return False
+        self._command_k = k
+        self.on_time += 1
+        self.latency.add(latency_s)
+        return True
+
+    def tick(self, k: int) -> None:
+        """The tick that applies the command of sample k: late when none came for k."""
+        if self._command_k != k and self.on_time:
+            self.late += 1
+
+    def next_deadline(self, deadline: float, now: float, period_s: float) -> float:
+        """The tick after the one due at ``deadline`` (monotonic s); when ``now`` is more than a
+        period (s) past it, the loop resynchronises to ``now`` and counts the missed ticks."""
+        deadline += period_s
+        if now - deadline > period_s:
+            self.missed_ticks += int((now - deadline) / period_s)
+            deadline = now + period_s
+        return deadline
+
+    def result(self, cycles: int, refused: int, limited: int, watchdog_trips: int) -> CycleStats:
+        """The statistics so far, with the run's cycles and its guard's and watchdog's counts."""
+        total = self.on_time + self.late
+        return CycleStats(
+            cycles=cycles,
+            commands_on_time=self.on_time,
+            commands_late=self.late,
+            on_time_pct=100.0 * self.on_time / total if total else math.nan,
+            missed_ticks=self.missed_ticks,
+            latency_p50_ms=self.latency.percentile(50) * 1e3,
+            latency_p99_ms=self.latency.percentile(99) * 1e3,
+            refused_commands=refused,
+            limited_commands=limited,
+            watchdog_trips=watchdog_trips,
+        )

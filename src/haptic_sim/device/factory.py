@@ -1,0 +1,78 @@
+"""Build a simulated device from parameters: the device node and batch runs share it.
+
+``model: slide`` builds the ``SimulatedSlide`` (its physics ``plant.``, its axis ``slide.axis``; the
+model an observer assumes, ``slide.*``, is not the plant's truth); ``model: phantom``
+or ``urdf`` a ``SimulatedArm`` of the model ``build_model`` names (groups ``phantom.`` or the URDF
+parameters, and ``arm.``), touching the wall ``contact.*`` when its stiffness is > 0 (a
+teleoperation slave's remote environment, ``haptic_sim.arm.contact``). ``sensor.`` and ``hand.``
+serve both.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import replace
+from typing import Any
+
+from haptic_dob.core.environment import VirtualWall
+from haptic_dob.core.models.factory import build_model
+from haptic_dob.core.models.slide import SlideParams
+from haptic_dob.runtime.params import ParamSpec, build, specs_of
+from haptic_sim.arm.device import ArmDeviceParams, SimulatedArm
+from haptic_sim.hand import HandParams
+from haptic_sim.sensor import ForceSensorParams
+from haptic_sim.slide.device import SimulatedSlide, SlideDeviceParams
+from haptic_sim.slide.session import LoopSettings
+
+#: an arm touches nothing unless ``contact.stiffness_n_per_m`` says so
+NO_CONTACT = {"contact.stiffness_n_per_m": 0.0}
+
+
+def contact_specs() -> list[ParamSpec]:
+    """``contact.*``: the wall an arm touches (one-sided; zero stiffness: none)."""
+    return [
+        replace(
+            s,
+            description=f"arms, the wall the tip touches: {s.description}"
+            + ("; 0 = nothing to touch" if s.name in NO_CONTACT else ""),
+            default=NO_CONTACT.get(s.name, s.default),
+        )
+        for s in specs_of(VirtualWall, "contact.", read_only=True)
+        if s.name != "contact.two_sided"
+    ]
+
+
+def simulation_specs() -> list[ParamSpec]:
+    """Sub-steps, seed, length, plant, sensor and hand (read-only: they define the run)."""
+    return [
+        *(s for s in specs_of(LoopSettings, read_only=True) if s.name != "rate_hz"),
+        *specs_of(SlideDeviceParams, "plant.", read_only=True),
+        *specs_of(ArmDeviceParams, "arm.", read_only=True),
+        *contact_specs(),
+        *specs_of(ForceSensorParams, "sensor.", read_only=True),
+        *specs_of(HandParams, "hand.", read_only=True),
+    ]
+
+
+def build_device(values: Mapping[str, Any]) -> SimulatedSlide | SimulatedArm:
+    """The simulated device the parameters describe (``model``: slide, phantom or urdf)."""
+    kind = values.get("model", "slide")
+    loop = build(LoopSettings, values)
+    if kind == "slide":
+        return SimulatedSlide(
+            build(SlideDeviceParams, values, "plant."),
+            build(ForceSensorParams, values, "sensor."),
+            build(HandParams, values, "hand."),
+            *loop.device_args(),
+            axis=build(SlideParams, values, "slide.").axis,
+        )
+    if kind in ("phantom", "urdf"):
+        return SimulatedArm(
+            build_model(values),
+            build(ArmDeviceParams, values, "arm."),
+            build(ForceSensorParams, values, "sensor."),
+            build(HandParams, values, "hand."),
+            *loop.device_args(),
+            contact=build(VirtualWall, {**NO_CONTACT, **values}, "contact."),
+        )
+    raise ValueError(f"device_node simulates model slide, phantom or urdf, got {kind!r}")

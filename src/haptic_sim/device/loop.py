@@ -1,0 +1,359 @@
+"""The simulated device's cycle, ROS-free: when sample k goes out and which command moves the plant.
+
+- lockstep: sample 0 goes out once the graph is up (``LoopPort.waiting_for``) and settled; sample
+  k+1 only after command k arrived (labelled with sample k's stamp, or unlabelled). Without a
+  command for ``lockstep_timeout_s`` the loop says so and sends sample k again. While a recorder
+  lags (``RecorderGate``) command k is held; after the last sample the run ends once the recorder
+  has written it.
+- realtime: ticks every period once the graph is up and applies the newest valid command; the
+  watchdog (``CommandWatchdog``) zeroes the effort when commands stop; ``RealtimeStats`` counts
+  whether command k came before the next tick.
+
+Every command passes the ``CommandGuard`` first. The node behind ``LoopPort`` publishes, runs
+deferred work and answers questions about the ROS graph; the loop tells it what to do.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from typing import Any, Protocol
+
+from haptic_dob.core.command_guard import CommandGuard
+from haptic_dob.core.watchdog import CommandWatchdog
+from haptic_msgs_py.topics import EFFORT_COMMAND
+from haptic_msgs_py.values import EffortCommand
+from haptic_sim.arm.device import SimulatedArm
+from haptic_sim.device.cycle_stats import CycleStats, RealtimeStats
+from haptic_sim.device.recorder_gate import Drain, RecorderGate
+from haptic_sim.device.sample import DeviceSample
+from haptic_sim.device.settings import DeviceLoopSettings
+from haptic_sim.slide.device import SimulatedSlide
+
+STARTUP_RESEND_S = 0.5  # lockstep: sample 0 again this often until command 0 comes
+GRAPH_POLL_S = 0.05  # how often the start and the end of a run look at the graph again
+WATCHDOG_SAY_EVERY_S = 1.0  # the watchdog says at most a line this often; news waits, never lost
+
+
+class LoopPort(Protocol):
+    """What the loop needs from its node: the topics, deferred work and the ROS graph."""
+
+    def publish(self, sample: DeviceSample) -> None:
+        """Send sample k to every topic."""
+
+    def call_soon(self, work: Callable[[], None]) -> None:
+        """Run ``work`` once the publishes under way have returned (at once when none is)."""
+
+    def waiting_for(self) -> str:
+        """What the start still waits for in the graph ('' when nothing)."""
+
+    def recorders(self) -> int:
+        """How many recorders report their progress."""
+
+    def cycled(self) -> None:
+        """One cycle ran (for the loop rate in the diagnostics)."""
+
+    def finish(self) -> None:
+        """The run is over: the node may stop."""
+
+
+class Log(Protocol):
+    """Where the loop says what it does (a ROS logger: ``throttle_duration_sec`` and so on)."""
+
+    def info(self, message: str, **kwargs: Any) -> Any: ...
+
+    def warning(self, message: str, **kwargs: Any) -> Any: ...
+
+
+class DeviceLoop:
+    """One simulated device in the cycle contract, in lockstep or in real time.
+
+    Args:
+        device: the simulated device (its sample k is the loop's cycle).
+        port: the node's topics, deferred work and graph.
+        log: where the loop says what it does.
+        values: the node's parameter values (``settings_for``; ``ValueError`` when refused).
+        lockstep: lockstep (True) or real time.
+        last_k: the run ends after publishing this sample (None: never).
+    """
+
+    def __init__(
+        self,
+        device: SimulatedSlide | SimulatedArm,
+        port: LoopPort,
+        log: Log,
+        values: Mapping[str, Any],
+        lockstep: bool,
+        last_k: int | None,
+    ) -> None:
+        self.device = device
+        self.port = port
+        self.log = log
+        self.lockstep = lockstep
+        self.last_k = last_k
+        self.period_ns = device.period_ns
+        self.guard = CommandGuard(device.max_effort, self._say_refusing)
+        self.configure(self.settings_for(values))
+        self.watchdog = CommandWatchdog(self.period_ns, self._say_tripped, self._say_resumed)
+        self._news: tuple[bool, str] | None = None  # the watchdog's unsaid line (warning?, text)
+        self._say_after = -float("inf")  # monotonic s before which the watchdog says nothing
+        self.realtime = RealtimeStats()
+        self.recorders = RecorderGate()
+        self.zero = [0.0] * device.dof
+        self.latest = self.zero  # realtime: the newest valid command
+        self.started = False
+        self.stepped = False  # lockstep: command k applied, sample k+1 not yet published
+        self.ready_since: float | None = None  # monotonic s the graph was first up
+        self.t_first = 0.0  # monotonic s of sample 0
+        self.deadline = time.monotonic() + 0.1  # monotonic s of the next wake-up
+        self.sent_s = 0.0  # monotonic s the newest sample went out
+
+    def settings_for(self, values: Mapping[str, Any]) -> DeviceLoopSettings:
+        """The settings parameter values ask for; ``ValueError`` with the reason when refused
+        (``effort_limits`` of another length or beyond the actuator's saturation)."""
+        return DeviceLoopSettings.of(values, self.guard.limits_for(values["effort_limits"]))
+
+    def configure(self, settings: DeviceLoopSettings) -> None:
+        """Take new settings: the next command is clipped to their limits."""
+        self.settings = settings
+        self.guard.limits = settings.effort_limits
+
+    # --- what the loop says -------------------------------------------------------------------
+    def _say_refusing(self, effort: tuple[float, ...]) -> None:
+        self.log.warning(
+            f"refusing effort_command {list(effort)!r}: need {self.device.dof} finite values; "
+            "zero effort until a valid command"
+        )
+
+    def _say_tripped(self, held: str) -> None:
+        """A trip, said once the tick's sample is out (``_say_pending``)."""
+        timeout = self.settings.command_timeout_s
+        self._news = (
+            True,
+            f"watchdog: no valid {EFFORT_COMMAND} for {held} (limit {timeout * 1e3:g} ms of "
+            f"simulated time): effort zeroed ({self.watchdog.trips} trips so far)",
+        )
+
+    def _say_resumed(self) -> None:
+        """The end of a trip, said after the next tick's sample; a trip not said yet is said
+        with it."""
+        resumed = "valid effort_command again: effort resumed"
+        if self._news is not None and self._news[0]:
+            self._news = (True, f"{self._news[1]}; {resumed}")
+        else:
+            self._news = (False, f"{resumed} (after trip {self.watchdog.trips})")
+
+    def _say_pending(self, now: float) -> None:
+        """Say the watchdog's newest news, at most one line every ``WATCHDOG_SAY_EVERY_S``: a
+        controller that comes and goes does not flood the log, and a trip soon after another
+        (a start-up trip, then a lost link) is said late rather than not at all."""
+        if self._news is not None and now >= self._say_after:
+            warning, line = self._news
+            (self.log.warning if warning else self.log.info)(line)
+            self._news = None
+            self._say_after = now + WATCHDOG_SAY_EVERY_S
+
+    # --- inputs ---------------------------------------------------------------------------
+    def command(self, cmd: EffortCommand) -> None:
+        """An effort command arrived (labelled with its sample's stamp, or unlabelled)."""
+        stamp = cmd.stamp_ns
+        k = self.device.k
+        current = k * self.period_ns
+        if self.lockstep:
+            if not self.started or (stamp is not None and stamp != current):
+                return  # stale, duplicate, or before the run started
+            if self.recorders.draining or self.stepped:
+                return  # the run is over, or command k already moved the plant
+            effort = self.guard.check(cmd.effort)
+            if effort is None:
+                effort = self.zero  # a refused command is zero effort; the loop goes on
+            if self.recorders.lags(current, self.settings.max_recorder_lag_s):
+                self.recorders.hold(effort)  # the recorder's progress releases it
+                return
+            self.advance(effort)
+            return
+        effort = self.guard.check(cmd.effort)
+        if effort is None:
+            self.latest = self.zero
+            return
+        now = time.monotonic()
+        self.latest = effort
+        self.watchdog.fed(k)
+        if stamp == current and self.realtime.command(k, now - self.sent_s):
+            self.port.call_soon(self.device.prepare)  # the loop is idle until the next tick
+
+    def progress(self, recorder: str, written_ns: int) -> None:
+        """Recorder ``recorder`` has written the samples up to stamp ``written_ns``."""
+        self.recorders.report(recorder, written_ns, time.monotonic())
+        if self.recorders.draining:
+            self.check_drained()
+            return
+        k_ns = self.device.k * self.period_ns
+        effort = self.recorders.release(k_ns, self.settings.max_recorder_lag_s)
+        if effort is not None:
+            self.advance(effort)
+
+    # --- the plant and the samples ----------------------------------------------------------
+    def advance(self, effort: list[float]) -> None:
+        """Command k reaches the plant: held over [k, k+1), the device steps to sample k+1.
+
+        In lockstep sample k+1 goes out once this cycle's publishes have returned (at once when
+        the command came from another process).
+        """
+        self.device.apply(effort)
+        if self.lockstep:
+            self.stepped = True
+            self.port.call_soon(self.send_sample)
+
+    def publish(self, sample: DeviceSample) -> None:
+        """Sample k to every topic (its send time starts the command's latency)."""
+        self.sent_s = time.monotonic()
+        self.port.publish(sample)
+
+    def send_sample(self) -> None:
+        """Publish the current sample; in lockstep arm the re-send and end the run at its end."""
+        self.stepped = False
+        s = self.device.sample()
+        last = self.last_k is not None and s.k >= self.last_k and not self.recorders.draining
+        if last:  # the run ends with this sample: a command that answers it moves nothing
+            self.recorders.start_drain(time.monotonic())
+        self.publish(s)
+        self.port.cycled()
+        if self.lockstep:
+            self.device.prepare()  # while the others work on sample k
+            self.deadline = self.sent_s + self.settings.lockstep_timeout_s
+        if last:
+            wall = time.monotonic() - self.t_first
+            sim = s.k * self.period_ns * 1e-9
+            self.log.info(
+                f"finished: {s.k} cycles ({sim:g} s simulated) in {wall:.2f} s, "
+                f"real-time factor {sim / wall:.2f}"
+            )
+            # stay up (publishers alive) until a recorder has written the last sample
+            self.deadline = time.monotonic()
+            self.check_drained()
+
+    def check_drained(self) -> None:
+        """Finish once no recorder reports, or it has written the last sample (or time is up)."""
+        last_ns = self.device.k * self.period_ns
+        drain = self.recorders.drain(last_ns, self.port.recorders(), time.monotonic())
+        if drain is Drain.TIMED_OUT:
+            self.log.warning(
+                "the recorder has not written the last sample after "
+                f"{self.recorders.drain_timeout_s:g} s; stopping anyway"
+            )
+        if drain is not Drain.WAITING:
+            self.port.finish()
+
+    # --- time -----------------------------------------------------------------------------
+    def wakeup(self, now: float) -> None:
+        """Called at or after ``deadline`` (monotonic ``now``, s)."""
+        if self.recorders.draining:  # the run is over: wait for the recorder
+            self.check_drained()
+            self.deadline = now + GRAPH_POLL_S
+            return
+        if not self.started:
+            settling = self.ready_since is not None
+            if not self.graph_ready():  # again after the settle time: entities that came late
+                self.ready_since = None
+                self.deadline = now + GRAPH_POLL_S
+                return
+            if not settling:
+                self.ready_since = now
+                if self.lockstep or self.settings.wait_for:
+                    self.deadline = now + self.settings.start_delay_s
+                    return
+        if not self.lockstep:
+            self.tick(now)
+        elif not self.started:
+            self.started = True
+            self.t_first = now
+            self.publish(self.device.sample())
+            self.deadline = now + STARTUP_RESEND_S
+        else:
+            self.lockstep_timeout(now)
+
+    def graph_ready(self) -> bool:
+        """Every ``wait_for`` node is up, known subscribers matched, a command publisher seen,
+        every recorder's readers matched.
+
+        While not, says what it waits for (every 5 s), so a device that does not start says why.
+        """
+        waiting = self.port.waiting_for()
+        if not waiting and self.recorders.unmatched(self.port.recorders()):
+            waiting = "the recorders' readers to match the loop's topics"
+        if waiting:
+            self.log.info(
+                f"waiting before sample 0 for {waiting} (wait_for: {list(self.settings.wait_for)})",
+                throttle_duration_sec=5.0,
+            )
+        return not waiting
+
+    def lockstep_timeout(self, now: float) -> None:
+        """Lockstep, no command moved the plant in time: hold for the recorder, or send again."""
+        k = self.device.k
+        timeout_s = self.settings.lockstep_timeout_s
+        held = self.recorders.held
+        if held is not None:  # waiting for the recorder, not for a command
+            if self.port.recorders() == 0:  # the recorder is gone: go on
+                self.log.warning("the recorder stopped reporting; the loop goes on")
+                self.recorders.let_go()
+                self.advance(held)
+                return
+            self.deadline = now + timeout_s
+            self.log.warning(
+                "holding the loop: the recorder is "
+                f"{self.recorders.behind_s(k * self.period_ns):.2f} s behind",
+                throttle_duration_sec=5.0,
+            )
+            return
+        if self.stepped:  # sample k+1 is on its way (deferred work not run yet)
+            self.deadline = now + timeout_s
+            return
+        if k == 0:
+            self.publish(self.device.sample())  # start-up: a late subscriber may have missed it
+            self.deadline = now + STARTUP_RESEND_S
+            return
+        self.log.warning(
+            f"no {EFFORT_COMMAND} for cycle {k} (stamp {k * self.period_ns * 1e-9:.3f} s) within "
+            f"{timeout_s:g} s; is controller_node running and "
+            "receiving its inputs? Sending the sample again."
+        )
+        self.publish(self.device.sample())
+        self.deadline = now + timeout_s
+
+    def tick(self, now: float) -> None:
+        """Real time: apply the newest valid command (zero when the watchdog trips), send the
+        next sample, schedule the next tick (sample 0 on the first)."""
+        period = self.period_ns * 1e-9
+        if not self.started:
+            self.started = True
+            self.t_first = now
+            self.publish(self.device.sample())
+            self.deadline = now + period
+            return
+        k = self.device.k
+        self.realtime.tick(k)  # late when command k did not come (once the loop has closed)
+        effort = self.latest
+        if self.watchdog.due(k, self.settings.command_timeout_s):
+            effort = self.zero
+        self.advance(effort)
+        self.send_sample()
+        self._say_pending(now)
+        self.deadline = self.realtime.next_deadline(self.deadline, now, period)
+
+    # --- end ------------------------------------------------------------------------------
+    def stats(self) -> CycleStats:
+        """Real-time cycle statistics so far."""
+        guard = self.guard
+        return self.realtime.result(
+            self.device.k, guard.refused, guard.limited, self.watchdog.trips
+        )
+
+    def shutdown(self) -> None:
+        """Zero effort first; in real time one last period runs and is reported with it."""
+        self.latest = self.zero
+        if not self.lockstep and self.started:
+            self.advance(self.zero)
+            self.send_sample()
+        self._say_pending(float("inf"))  # the watchdog's last news, however soon after a line

@@ -1,0 +1,3 @@
+"""Teleoperation in batch: configuration, session, stability sweep, results, figures, recorded
+bags.
+"""
