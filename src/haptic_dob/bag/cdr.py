@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from haptic_msgs_py.stamps import COMMAND_LABEL, NS_PER_S
+from haptic_msgs_py.stamps import COMMAND_LABEL, NS_PER_S, TOKEN_MARK
 from haptic_msgs_py.wire import TYPESTORE
 
 #: stamped geometry types: the message's 3-vector field read as components 0..2 after the header
@@ -47,7 +47,8 @@ def header_stamp_ns(data: bytes | memoryview) -> int | None:
 
 
 def command_label_stamp_ns(data: bytes | memoryview) -> int | None:
-    """The stamp named by a little-endian ``Float64MultiArray``'s first label (``effort@<ns>``)."""
+    """The stamp named by a little-endian ``Float64MultiArray``'s first label (``effort@<ns>``,
+    a sender's ``#<token>`` after it)."""
     if len(data) < 12 or data[1] != 1 or _U32.unpack_from(data, 4)[0] < 1:
         return None
     n = _U32.unpack_from(data, 8)[0]
@@ -55,7 +56,7 @@ def command_label_stamp_ns(data: bytes | memoryview) -> int | None:
     if not label.startswith(COMMAND_LABEL.encode()):
         return None
     try:
-        return int(label[len(COMMAND_LABEL) :])
+        return int(label[len(COMMAND_LABEL) :].partition(TOKEN_MARK.encode())[0])
     except ValueError:
         return None
 

@@ -17,7 +17,10 @@ Network: by default every node's discovery stays on this host
 (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), so a simulated session never reaches a lab network
 by accident. ``--network subnet`` lets them discover across the subnet, ``--peers`` adds named
 hosts (``ROS_STATIC_PEERS``), and ``--only`` starts a subset: the device on one host and the rest
-on another (see docs/running.md, "Lab network and security").
+on another (see docs/running.md, "Lab network and security"). The launch says which domain and
+discovery range its nodes use, and how each device takes its commands: a device and its
+controller started together share a fresh command token (``command_token``), which every command
+from another process must carry.
 
 A teleoperation YAML (``/master/...`` and ``/slave/...`` sections) starts the two sides' nodes in
 their namespaces, all in one process by default; ``--group`` and ``--only`` take sides there
@@ -32,6 +35,7 @@ from pathlib import Path
 
 from haptic_dob.cli.common import ArgumentParser, run
 from haptic_dob.launcher.node_params import (
+    add_command_tokens,
     add_cpu_latency,
     add_pinning,
     add_recorder,
@@ -45,6 +49,7 @@ from haptic_dob.launcher.options import (
     network_env,
     normalize_namespace,
     parse_sets,
+    say_session,
 )
 from haptic_dob.launcher.process_plan import check_pinnable, groups_for, plan, select
 from haptic_dob.launcher.supervise import check_cpu_latency_request, launch, set_rt_priority
@@ -78,6 +83,7 @@ def command(opts: LaunchOptions) -> int:
         set_rt_priority(opts.rt_priority)
     if opts.executor:
         net["HAPTIC_DOB_EXECUTOR"] = opts.executor
+    say_session(net, add_command_tokens(params, names))
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
         chosen = {n: v for n, v in params.items() if n == "/**" or n in names}
         specs = plan(chosen, write_params_file(params, Path(tmp)), namespace, groups)

@@ -1,16 +1,19 @@
 """The nodes' parameter table of one launch: the config's node sections with ``--set`` applied,
-what ``--record``, ``--pin`` and ``--cpu-latency`` add, and the params file every node reads.
+what ``--record``, ``--pin`` and ``--cpu-latency`` add, the session's command token, and the
+params file every node reads.
 
 The table maps a node's name (or ``/**``, every node) to its flat ``{param: value}``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from haptic_dob.core.command_authority import new_token
 from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import NODES
 from haptic_dob.runtime.params import load_node_params
@@ -76,6 +79,47 @@ def add_cpu_latency(params: dict[str, Any], latency_us: int) -> None:
     for name in (n for pair in PAIRS for n in pair if n in params):
         if params[name].get("cpu_latency_us", common) in (None, NO_REQUEST):
             params[name]["cpu_latency_us"] = latency_us
+
+
+#: the nodes that take ``effort_command`` at a device end (the device bridge is one too)
+DEVICE_ENDS = ("device_node", "bridge_node")
+DEFAULT_SOURCE = "controller_node"
+
+
+def add_command_tokens(params: dict[str, Any], started: Sequence[str]) -> list[str]:
+    """One fresh command token for every device end in ``started`` and its ``command_source``,
+    when that starts too and no token was given (config, ``--set``); what each device end takes
+    its commands by, a line each. Names may carry a namespace (``slave/device_node``), where the
+    source is looked for beside the device end."""
+    common = params.get("/**", {})
+    token = new_token()
+    lines = []
+    for name in started:
+        ns, _, node = name.rpartition("/")
+        if node not in DEVICE_ENDS:
+            continue
+        values = params.setdefault(name, {})
+
+        def given(key: str, default: Any, values: dict[str, Any] = values) -> Any:
+            return values.get(key, common.get(key, default))
+
+        source = given("command_source", DEFAULT_SOURCE)
+        source_key = f"{ns}/{source}" if ns else source
+        if given("open_command_input", False):
+            how = "from any publisher (open_command_input)"
+        elif given("command_token", ""):
+            how = f"only from {source}, by the command_token given"
+        elif source_key in started:
+            values["command_token"] = token
+            params.setdefault(source_key, {})["command_token"] = token
+            how = f"only from {source}, by this launch's command token"
+        else:
+            how = (
+                f"only from {source}, which starts elsewhere: by its node name and GID in the "
+                "graph (give both the same command_token to check every command)"
+            )
+        lines.append(f"{name} takes effort_command {how}")
+    return lines
 
 
 def write_params_file(params: dict[str, Any], directory: Path) -> Path:

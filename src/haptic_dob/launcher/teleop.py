@@ -27,7 +27,8 @@ from typing import Any
 import yaml
 
 from haptic_dob.errors import InputError
-from haptic_dob.launcher.options import LaunchOptions, network_env
+from haptic_dob.launcher.node_params import add_command_tokens
+from haptic_dob.launcher.options import LaunchOptions, network_env, say_session
 from haptic_dob.launcher.process_plan import ProcessSpec, executable
 from haptic_dob.launcher.supervise import launch, set_rt_priority
 from haptic_dob.nodes.registry import CONTAINER, NODES
@@ -41,13 +42,17 @@ from haptic_dob.teleop.graph import (
     recorded_topics,
 )
 
+#: the slave device's commands come from its slave controller
+SLAVE_SOURCE = "slave_controller_node"
+
 
 def teleop_params(
     sections: Mapping[str, Mapping[str, Any]], sets: Sequence[str]
 ) -> dict[str, dict[str, Any]]:
     """``{"master/device_node": {param: value}, ...}`` for every node, ``--set`` applied; a side
     whose device runs in real time gets ``wait_for_peer: false`` on its channel end unless given
-    (waiting for the peer's messages is lockstep's)."""
+    (waiting for the peer's messages is lockstep's), and the slave's device takes its commands
+    from the slave controller unless told otherwise."""
     try:
         check_sections(sections)
     except ValueError as exc:
@@ -73,6 +78,7 @@ def teleop_params(
     for ns in NAMESPACES:  # a real-time side's channel end uses what has come (no lockstep wait)
         if out[f"{ns}/device_node"].get("clock_mode") == "realtime":
             out[f"{ns}/channel_node"].setdefault("wait_for_peer", False)
+    out["slave/device_node"].setdefault("command_source", SLAVE_SOURCE)
     return out
 
 
@@ -209,6 +215,7 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
         set_rt_priority(opts.rt_priority)
     if opts.executor:
         net["HAPTIC_DOB_EXECUTOR"] = opts.executor
+    say_session(net, add_command_tokens(params, names))
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
         specs = teleop_plan(params, write_teleop_params(params, Path(tmp)), groups)
         for spec in specs:

@@ -1,9 +1,10 @@
 """The device node's parameters: the rows it declares and the settings its loop reads of them.
 
 ``device_node_specs`` is the whole table (``docs/parameters.md`` lists it in this order):
-``safety_specs`` (the watchdog's timeout, the command guard's limits), the loop, process, model,
-clock and simulation rows, then ``schedule_specs`` (lockstep re-sends, the start-up gate,
-recorder back-pressure, the statistics file). ``DeviceLoopSettings`` is what the loop reads of
+``safety_specs`` (the watchdog's timeout, the command guard's limits), the loop, input, command
+authority (who may command the device), process, model, clock and simulation rows, then
+``schedule_specs`` (lockstep re-sends, the start-up gate, recorder back-pressure, the statistics
+file). ``DeviceLoopSettings`` is what the loop reads of
 them at run time; ``missing_nodes`` which of ``wait_for`` the graph lacks.
 """
 
@@ -14,7 +15,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from haptic_dob.core.models.factory import model_specs
-from haptic_dob.nodes.common import CLOCK_MODES, input_specs, loop_specs, process_specs
+from haptic_dob.nodes.common import (
+    CLOCK_MODES,
+    command_authority_specs,
+    input_specs,
+    loop_specs,
+    process_specs,
+)
 from haptic_dob.runtime.params import ParamSpec
 from haptic_sim.device.factory import simulation_specs
 
@@ -31,6 +38,7 @@ def device_node_specs() -> list[ParamSpec]:
         *safety_specs(),
         *loop_specs(),
         *input_specs("reliable"),
+        *command_authority_specs(),
         *process_specs(),
         # the slide's physics is plant.* (its truth); slide.* is the model the others assume
         *(s for s in model_specs() if s.name not in ASSUMED_ONLY),

@@ -21,8 +21,13 @@ Safety (every path, both modes): each joint's effort is clamped to ``effort_limi
 actuator's own saturation; changeable at run time); a command of the wrong length or with NaN/inf
 is refused and counts as zero effort (counted, logged once per burst); in real time a watchdog
 zeroes the effort when no valid command came for ``command_timeout_s`` and says so, and the next
-valid command resumes; at shutdown the effort goes to zero first. ``/diagnostics`` reports the
-loop rate, deadline misses, the watchdog, refused and limited commands.
+valid command resumes; at shutdown the effort goes to zero first. Only the loop's own controller
+commands it (``haptic_dob.nodes.command_input``): in process when composed, or from another
+process with the session's ``command_token``; another publisher's commands are refused, counted
+and named once each, unless ``open_command_input`` (off by default, as on a real device: sessions
+rehearsed on the simulator hold on hardware). It does not warn about the DDS domain and discovery
+range as a real device's bridge does: nothing here can push on a hand. ``/diagnostics`` reports
+the loop rate, deadline misses, the watchdog, refused, limited and foreign commands.
 """
 
 from __future__ import annotations
@@ -36,13 +41,14 @@ from typing import Any
 
 from rclpy.context import Context
 
+from haptic_dob.nodes.command_input import CommandInput
 from haptic_dob.nodes.common import main_for
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
-from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
+from haptic_msgs_py.ros.loop_io import LoopPublisher
 from haptic_msgs_py.ros.raw import raw_subscription
 from haptic_msgs_py.stamps import NS_PER_S
 from haptic_msgs_py.topics import (
@@ -105,7 +111,7 @@ class DeviceNode(LoopNode):
         # record --use-sim-time, a node's -p use_sim_time:=true) share the loop's time base
         self._p_clock = LoopPublisher(self, CLOCK, codecs.CLOCK, qos.CLOCK, on_demand=True)
         inputs = qos.loop_input(v["input_reliability"])
-        self._sub = LoopSubscription(self, EFFORT_COMMAND, codecs.EFFORT, self.loop.command, inputs)
+        self._sub = CommandInput(self, self.loop.command, inputs, v)
         self._bus = self._sub.bus
         # both modes: sample 0 waits for the recorders' readers to match; lockstep back-pressure
         raw_subscription(
@@ -214,6 +220,7 @@ class DeviceNode(LoopNode):
             "refused_commands": loop.guard.refused,
             "limited_commands": loop.guard.limited,
             "effort_limits": list(self.limits),
+            **self._sub.report(),
         }
         if not self.lockstep:
             rt = loop.realtime
@@ -224,6 +231,8 @@ class DeviceNode(LoopNode):
             return WARN, "watchdog tripped: no valid effort_command, effort zeroed", values
         if loop.guard.refusing:
             return WARN, "refusing invalid effort_command (zero effort)", values
+        if self._sub.refusing():
+            return WARN, "refused effort_command from publishers other than the loop's", values
         if not loop.started:
             return OK, "waiting for the graph", values
         return OK, "running", values
