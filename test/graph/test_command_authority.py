@@ -121,13 +121,9 @@ def session(layout: str, open_input: bool, tmp_path: Path) -> dict[str, Any]:
         n = col.count(JOINT_STATES)
         assert col.wait_for(JOINT_STATES, n + 500, 60), log()  # the loop still runs
         efforts = [m.effort[0] for m in col.decoded(JOINT_STATES)()]
-        return {
-            "sent": sent,
-            "counted": counted,
-            "values": values,
-            "efforts": efforts,
-            "log": log(),
-        }
+        text = log()
+        assert f"haptic-launch: domain {env['ROS_DOMAIN_ID']}, discovery localhost" in text
+        return {"sent": sent, "counted": counted, "values": values, "efforts": efforts, "log": text}
     finally:
         for p in procs:
             p.stop()
