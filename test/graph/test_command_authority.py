@@ -35,7 +35,9 @@ from std_msgs.msg import Float64MultiArray, MultiArrayDimension
 name, label, count, value = sys.argv[1], sys.argv[2], int(sys.argv[3]), float(sys.argv[4])
 rclpy.init()
 node = rclpy.create_node(name)
-pub = node.create_publisher(Float64MultiArray, "effort_command", 10)
+# as deep as its commands: a busy reader that acknowledges late loses none (at depth 10, the
+# writer would drop what the device had not acknowledged yet, and the count would fall short)
+pub = node.create_publisher(Float64MultiArray, "effort_command", count)
 end = time.monotonic() + 60.0
 while pub.get_subscription_count() < 1 and time.monotonic() < end:
     time.sleep(0.01)
