@@ -22,12 +22,9 @@ actuator's own saturation; changeable at run time); a command of the wrong lengt
 is refused and counts as zero effort (counted, logged once per burst); in real time a watchdog
 zeroes the effort when no valid command came for ``command_timeout_s`` and says so, and the next
 valid command resumes; at shutdown the effort goes to zero first. Only the loop's own controller
-commands it (``haptic_dob.nodes.command_input``): in process when composed, or from another
-process with the session's ``command_token``; another publisher's commands are refused, counted
-and named once each, unless ``open_command_input`` (off by default, as on a real device: sessions
-rehearsed on the simulator hold on hardware). It does not warn about the DDS domain and discovery
-range as a real device's bridge does: nothing here can push on a hand. ``/diagnostics`` reports
-the loop rate, deadline misses, the watchdog, refused, limited and foreign commands.
+commands it (``haptic_dob.nodes.command_input``; ``open_command_input``, off as on a real device,
+opens it). ``/diagnostics`` reports the loop rate, deadline misses, the watchdog, refused, limited
+and foreign commands.
 """
 
 from __future__ import annotations
