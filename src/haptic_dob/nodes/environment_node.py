@@ -1,8 +1,9 @@
 """environment_node: the virtual wall. ee_pose + ee_twist of sample k -> wrench_desired k.
 
 The wall (``stiffness_n_per_m``, ``damping_n_s_per_m``, ``position``, ``normal``, ``two_sided``)
-and a known force it adds along its normal at the sample's time (``excitation.*``: a step or a
-sine, the identification experiment's input) change at run time.
+and a known force it adds at the sample's time (``excitation.*``: a step or a sine along its
+normal, a chirp or a multisine along it or along each axis, and a holding spring: the
+identification experiment's input) change at run time.
 """
 
 from __future__ import annotations
