@@ -23,12 +23,11 @@ from haptic_dob.core.command_guard import CommandGuard
 from haptic_dob.core.watchdog import CommandWatchdog
 from haptic_msgs_py.topics import EFFORT_COMMAND
 from haptic_msgs_py.values import EffortCommand
-from haptic_sim.arm.device import SimulatedArm
 from haptic_sim.device.cycle_stats import CycleStats, RealtimeStats
+from haptic_sim.device.factory import SimulatedDeviceKind
 from haptic_sim.device.recorder_gate import Drain, RecorderGate
 from haptic_sim.device.sample import DeviceSample
 from haptic_sim.device.settings import DeviceLoopSettings
-from haptic_sim.slide.device import SimulatedSlide
 
 STARTUP_RESEND_S = 0.5  # lockstep: sample 0 again this often until command 0 comes
 GRAPH_POLL_S = 0.05  # how often the start and the end of a run look at the graph again
@@ -79,7 +78,7 @@ class DeviceLoop:
 
     def __init__(
         self,
-        device: SimulatedSlide | SimulatedArm,
+        device: SimulatedDeviceKind,
         port: LoopPort,
         log: Log,
         values: Mapping[str, Any],

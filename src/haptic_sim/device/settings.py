@@ -21,8 +21,18 @@ from haptic_sim.device.factory import simulation_specs
 DEFAULT_WAIT_FOR = ["environment_node", "observer_node", "controller_node"]
 
 
-#: model parameters a simulated device does not take (its own physics are ``plant.*``)
-ASSUMED_ONLY = frozenset({"slide.mass_kg", "slide.viscous_n_s_per_m", "slide.coulomb_n"})
+#: model parameters a simulated device does not take (its own physics are ``plant.*`` or
+#: ``cartesian.*``)
+ASSUMED_ONLY = frozenset(
+    {
+        "slide.mass_kg",
+        "slide.viscous_n_s_per_m",
+        "slide.coulomb_n",
+        "point_mass.mass_kg",
+        "point_mass.viscous_n_s_per_m",
+        "point_mass.coulomb_n",
+    }
+)
 
 
 def device_node_specs() -> list[ParamSpec]:
@@ -32,7 +42,8 @@ def device_node_specs() -> list[ParamSpec]:
         *loop_specs(),
         *input_specs("reliable"),
         *process_specs(),
-        # the slide's physics is plant.* (its truth); slide.* is the model the others assume
+        # the slide's physics is plant.* (its truth), the point mass's cartesian.*; slide.* and
+        # point_mass.* are the model the others assume
         *(s for s in model_specs() if s.name not in ASSUMED_ONLY),
         ParamSpec(
             "clock_mode",
