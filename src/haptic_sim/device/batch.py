@@ -1,0 +1,93 @@
+"""Any simulated device's session in batch, from the node graph's own parameters.
+
+``run_batch(nodes)`` takes the per-node parameter values a session YAML gives the graph
+(``load_node_params``: ``device_node``, ``environment_node``, ``observer_node``,
+``controller_node``, ``/**``) and runs their cycle in-process: the device the device node would
+simulate (``build_device``), the wall and excitation of the environment node, the observer on the
+observer's model, the law on the controller's model, each cycle the stages of
+``haptic_dob.core.cycle``. A lockstep graph launched with the same parameters records the same
+samples, to the bit; a record's joint states are what ``haptic-identify`` reads from that bag.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from haptic_dob.core.control import ImpedanceController, ImpedanceLaw
+from haptic_dob.core.cycle import LoopCycle
+from haptic_dob.core.environment import VirtualWall
+from haptic_dob.core.excitation import Excitation
+from haptic_dob.core.models.factory import build_model
+from haptic_dob.core.observers.factory import ObserverSettings
+from haptic_dob.runtime.params import build, node_view
+from haptic_sim.device.factory import build_device
+from haptic_sim.slide.session import LoopSettings
+
+Arr = NDArray[np.float64]
+NODES = ("device_node", "environment_node", "observer_node", "controller_node")
+
+
+@dataclass(frozen=True)
+class BatchRecord:
+    """One row per cycle k (SI units): what the device reported, what the loop computed, the
+    truth. Joint arrays are (N, dof) in ``joint_names`` order, Cartesian ones (N, 3)."""
+
+    joint_names: tuple[str, ...]
+    stamps_ns: NDArray[np.int64]
+    q: Arr
+    qd: Arr
+    effort: Arr  # applied over [k-1, k) after saturation
+    command: Arr  # command k, held over [k, k+1)
+    ee: Arr  # the end-effector point the device reported
+    wall_force: Arr  # the environment's force (wall, excitation, holding spring)
+    hand_force: Arr  # the true external force on the end effector (the hand's)
+    force_measured: Arr  # the handle's force sensor
+    force_estimated: Arr  # the observer's wrench
+
+    @property
+    def t(self) -> Arr:
+        """Sample times (s)."""
+        t: Arr = self.stamps_ns.astype(np.float64) * 1e-9
+        return t
+
+
+def run_batch(nodes: Mapping[str, Mapping[str, Any]], cycles: int | None = None) -> BatchRecord:
+    """Run the session ``nodes`` describe for ``cycles`` cycles (default: the device node's
+    ``duration_s`` at its ``rate_hz``); ``ValueError`` names a refused parameter."""
+    dev, env, obs, ctl = (node_view(nodes, n) for n in NODES)
+    loop = build(LoopSettings, dev)
+    device = build_device(dev)
+    observer_model, controller_model = build_model(obs), build_model(ctl)
+    for who, m in (("observer", observer_model), ("controller", controller_model)):
+        if tuple(m.joint_names) != tuple(device.model.joint_names):
+            raise ValueError(
+                f"the {who}'s model has joints {list(m.joint_names)}, the device "
+                f"{list(device.model.joint_names)}"
+            )
+    observer = build(ObserverSettings, obs).build(observer_model, device.period_ns * 1e-9)
+    cycle = LoopCycle(
+        build(VirtualWall, env),
+        observer,
+        ImpedanceController(controller_model, build(ImpedanceLaw, ctl)),
+        device.period_ns,
+        build(Excitation, env, "excitation."),
+    )
+    n, dof = loop.batch_cycles(cycles), device.dof
+    joint = np.empty((4, n, dof))
+    cart = np.empty((5, n, 3))
+    stamps = np.empty(n, dtype=np.int64)
+    for k in range(n):
+        s = device.sample()
+        f_wall, f_est, tau = cycle.step(
+            s.stamp_ns, s.q, s.qd, s.effort, s.ee_position, s.ee_velocity, s.wrench_measured
+        )
+        device.apply(tau)
+        stamps[k] = s.stamp_ns
+        joint[:, k] = (s.q, s.qd, s.effort, tau)
+        cart[:, k] = (s.ee_position, f_wall, s.hand_force, s.wrench_measured, f_est)
+    return BatchRecord(tuple(device.model.joint_names), stamps, *joint, *cart)
