@@ -13,12 +13,15 @@ import yaml
 
 from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import NODES
+from haptic_dob.runtime.configs import urdf_beside
 from haptic_dob.runtime.params import load_node_params
 
 
 def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """The config's node sections (flattened, ``--set`` applied), keyed by node name."""
+    """The config's node sections (flattened, ``--set`` applied), keyed by node name; a
+    relative ``urdf_path`` is taken from the config's directory."""
     out = load_node_params(config)
+    urdf_beside(out, config)
     unknown = [n for n in out if n != "/**" and n not in NODES]
     if unknown:
         raise InputError(

@@ -1,18 +1,19 @@
 """Any simulated device's session in batch, from the node graph's own parameters.
 
 ``run_batch(nodes)`` takes the per-node parameter values a session YAML gives the graph
-(``load_node_params``: ``device_node``, ``environment_node``, ``observer_node``,
-``controller_node``, ``/**``) and runs their cycle in-process: the device the device node would
-simulate (``build_device``), the wall and excitation of the environment node, the observer on the
-observer's model, the law on the controller's model, each cycle the stages of
-``haptic_dob.core.cycle``. A lockstep graph launched with the same parameters records the same
-samples, to the bit; a record's joint states are what ``haptic-identify`` reads from that bag.
-"""
+(``device_node``, ``environment_node``, ``observer_node``, ``controller_node``, ``/**``;
+``load_session`` reads them from a file as the launcher does) and runs their cycle in-process:
+the device the device node would simulate (``build_device``), the wall and excitation of the
+environment node, the observer on the observer's model, the law on the controller's model, each
+cycle the stages of ``haptic_dob.core.cycle``. A lockstep graph launched with the same parameters
+records the same samples, to the bit; a record's joint states are what ``haptic-identify`` reads
+from that bag."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -24,7 +25,8 @@ from haptic_dob.core.environment import VirtualWall
 from haptic_dob.core.excitation import Excitation
 from haptic_dob.core.models.factory import build_model
 from haptic_dob.core.observers.factory import ObserverSettings
-from haptic_dob.runtime.params import build, node_view
+from haptic_dob.runtime.configs import urdf_beside
+from haptic_dob.runtime.params import build, load_node_params, node_view
 from haptic_sim.device.factory import build_device
 from haptic_sim.slide.session import LoopSettings
 
@@ -54,6 +56,14 @@ class BatchRecord:
         """Sample times (s)."""
         t: Arr = self.stamps_ns.astype(np.float64) * 1e-9
         return t
+
+
+def load_session(path: str | Path) -> dict[str, dict[str, Any]]:
+    """A session YAML's per-node parameters as the launcher gives them to the nodes (a relative
+    ``urdf_path`` beside the file)."""
+    nodes = load_node_params(path)
+    urdf_beside(nodes, path)
+    return nodes
 
 
 def run_batch(nodes: Mapping[str, Mapping[str, Any]], cycles: int | None = None) -> BatchRecord:
