@@ -67,11 +67,14 @@ MODEL_NODES = ("observer_node", "controller_node")
 
 
 def model_yaml(params: Mapping[str, object], what: str, bag: str) -> str:
-    """A params file that sets ``params`` of the observer's and the controller's model."""
+    """A params file that sets ``params`` of the observer's and the controller's model (each
+    node its own copy of a list: YAML would alias a shared one, and rcl refuses aliases)."""
+    import copy
+
     import yaml
 
     head = f"# identified from {bag} by haptic-identify ({what})\n"
-    doc = {f"/**/{n}": {"ros__parameters": dict(params)} for n in MODEL_NODES}
+    doc = {f"/**/{n}": {"ros__parameters": copy.deepcopy(dict(params))} for n in MODEL_NODES}
     body: str = yaml.safe_dump(doc, sort_keys=False)
     return head + body
 
