@@ -113,6 +113,7 @@ def test_excite_record_identify_then_dob_through_the_graph(root: Path, tmp_path:
     t_est, est = vectors(dob_bag, WRENCH_ESTIMATE)
     assert np.array_equal(t_hand[:n], dob.stamps_ns) and np.array_equal(t_est[:n], dob.stamps_ns)
     np.testing.assert_array_equal(est[:n], dob.force_estimated)
+    np.testing.assert_array_equal(hand[:n], dob.hand_force)
     env = node_view(nodes, "environment_node")
     normal, point = np.asarray(env["normal"]), np.asarray(env["position"])
     contact = (js.position[:n] - point) @ normal > 0.0

@@ -12,33 +12,20 @@ amplifiers' lag, encoder counts after noise.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
-import numpy as np
 import pytest
 
 from haptic_dob.cli.identify import main
+from haptic_dob.core.environment import VirtualWall
 from haptic_dob.runtime.params import build, load_node_params, node_view
-from haptic_sim.device.batch import BatchRecord, run_batch
+from haptic_sim.device.batch import run_batch
 from haptic_sim.point_mass.device import PointMassDeviceParams
 from support.joint_bags import write_joint_states
 from support.paths import ROOT
 
 EXCITATION = ROOT / "config" / "point_mass_excitation.yaml"
 SESSION = ROOT / "config" / "point_mass_sim.yaml"
-SETTLE_S = 2.0  # the hand's ramp onto the floor, left out of the estimate's figure
 MODEL_DIGITS = 4
-
-
-def estimate_error(r: BatchRecord, nodes: dict[str, dict[str, Any]]) -> tuple[float, float]:
-    """RMS of the 3-D estimate error in contact after ``SETTLE_S`` (N) and the span of the true
-    force along the floor's normal in those samples (N)."""
-    env = node_view(nodes, "environment_node")
-    normal, point = np.asarray(env["normal"]), np.asarray(env["position"])
-    contact = (r.ee - point) @ normal > 0.0
-    contact[: round(SETTLE_S / (r.t[1] - r.t[0]))] = False
-    err = np.linalg.norm(r.force_estimated[contact] - r.hand_force[contact], axis=1)
-    return float(np.sqrt(np.mean(err**2))), float(np.ptp(r.hand_force[contact] @ normal))
 
 
 @pytest.fixture(scope="module")
@@ -88,6 +75,6 @@ def test_dob_with_the_identified_model_estimates_the_hand_within_5_percent(
     for node, values in load_node_params(identified).items():  # loaded after the session's config
         nodes[node] = {**nodes.get(node, {}), **values}
     r = run_batch(nodes)
-    rms, span = estimate_error(r, nodes)
-    assert span > 1.5 and np.mean((r.ee[:, 2] + 0.005) < 0.0) > 0.85  # pushing on the floor
-    assert rms <= 0.05 * span, (rms, span)
+    contact = r.in_contact(build(VirtualWall, node_view(nodes, "environment_node")))
+    assert contact.share > 0.85 and contact.span_n > 1.5  # pushing on the floor
+    assert contact.error_of_span <= 0.05, contact
