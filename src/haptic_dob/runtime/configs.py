@@ -39,10 +39,12 @@ def resolve_config(name_or_path: str | Path) -> Path:
 
 
 def urdf_beside(sections: Mapping[str, dict[str, Any]], config: str | Path) -> None:
-    """Take a relative ``urdf_path`` of any section from the config's own directory, in place
-    (the installed configs name ``urdf/arm7.urdf``, ``urdf/phantom_omni.urdf`` beside them)."""
+    """Take a relative ``urdf_path`` of any section from the config's own directory where the
+    file is there, in place (the installed configs name ``urdf/arm7.urdf``,
+    ``urdf/phantom_omni.urdf`` beside them); else it stays relative to the working directory."""
     here = Path(config).resolve().parent
     for values in sections.values():
         given = values.get("urdf_path")
-        if isinstance(given, str) and given and not Path(given).is_absolute():
-            values["urdf_path"] = str(here / given)
+        relative = isinstance(given, str) and given and not Path(given).is_absolute()
+        if relative and (here / str(given)).is_file():
+            values["urdf_path"] = str(here / str(given))
