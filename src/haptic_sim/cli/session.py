@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 from dataclasses import dataclass
@@ -9,14 +10,14 @@ from pathlib import Path
 from typing import Any
 
 from haptic_dob.cli.common import ArgumentParser, run
-from haptic_dob.core.control import ControlMode, ImpedanceLaw
+from haptic_dob.core.control import ControlMode
 from haptic_dob.core.environment import VirtualWall
-from haptic_dob.core.observers.factory import ObserverSettings
 from haptic_dob.core.validation import nonnegative, positive
 from haptic_dob.runtime.configs import resolve_config
-from haptic_dob.runtime.params import build, load_node_params, node_view
+from haptic_dob.runtime.params import load_node_params, node_view
+from haptic_sim.device.batch import BatchSummary, load_session, run_batch, summarize
 from haptic_sim.hand import reference_for_force
-from haptic_sim.slide.session import LoopSettings, SessionConfig, run_session
+from haptic_sim.slide.session import SessionConfig, run_session
 from haptic_sim.slide.stability import law_for
 
 
@@ -35,7 +36,8 @@ def command(
     model = node_view(load_node_params(path), "device_node").get("model", "slide")
     if model == "point_mass":
         overrides = Overrides(controller, kf, stiffness, duration, seed)
-        print_summary(run_cartesian(path, overrides, save), as_json)
+        figures = dataclasses.asdict(run_cartesian(path, overrides, save))
+        print_summary({**figures, "saved": save} if save else figures, as_json)
         return 0
     if model != "slide":
         summary = run_arm(path, controller, kf, stiffness, duration, seed, save)
@@ -115,12 +117,10 @@ class Overrides:
     seed: int | None
 
 
-def run_cartesian(path: Path, o: Overrides, save: str | None) -> dict[str, Any]:
+def run_cartesian(path: Path, o: Overrides, save: str | None) -> BatchSummary:
     """A Cartesian point-mass device's session (``haptic_sim.device.batch``), the overrides set
     as the nodes' parameters (``--stiffness`` leaves the hand's push as the config has it):
     headline figures of the estimate in contact."""
-    from haptic_sim.device.batch import load_session, run_batch
-
     nodes = load_session(path)
     ctl, env, dev = (
         nodes.setdefault(n, {}) for n in ("controller_node", "environment_node", "device_node")
@@ -136,26 +136,9 @@ def run_cartesian(path: Path, o: Overrides, save: str | None) -> dict[str, Any]:
     if o.seed is not None:
         dev["seed"] = int(nonnegative("--seed", o.seed))
     record = run_batch(nodes)
-    wall = build(VirtualWall, node_view(nodes, "environment_node"))
-    law = build(ImpedanceLaw, node_view(nodes, "controller_node"))
-    loop = build(LoopSettings, node_view(nodes, "device_node"))
-    contact = record.in_contact(wall)
-    summary: dict[str, Any] = {
-        "model": "point_mass",
-        "controller": law.mode.value,
-        "kf": law.kf,
-        "stiffness_n_per_m": wall.stiffness_n_per_m,
-        "observer_gain": build(ObserverSettings, node_view(nodes, "observer_node")).gain,
-        "duration_s": record.t.size / loop.rate_hz,
-        "seed": loop.seed,
-        "in_contact_pct": 100.0 * contact.share,  # after the hand's 2 s ramp-in
-        "estimate_rms_error_in_contact_n": contact.rms_error_n,
-        "hand_force_span_in_contact_n": contact.span_n,
-    }
     if save:
         record.save(save)
-        summary["saved"] = save
-    return summary
+    return summarize(record, nodes)
 
 
 def print_summary(summary: dict[str, Any], as_json: bool) -> None:

@@ -139,3 +139,40 @@ def run_batch(nodes: Mapping[str, Mapping[str, Any]], cycles: int | None = None)
         joint[:, k] = (s.q, s.qd, s.effort, tau)
         cart[:, k] = (s.ee_position, f_wall, s.hand_force, s.wrench_measured, f_est)
     return BatchRecord(tuple(device.model.joint_names), stamps, *joint, *cart)
+
+
+@dataclass(frozen=True)
+class BatchSummary:
+    """A session's headline figures: its settings and the estimate in contact."""
+
+    model: str
+    controller: str
+    kf: float
+    stiffness_n_per_m: float
+    observer_gain: float
+    duration_s: float
+    seed: int
+    in_contact_pct: float  # of the samples after the hand's ramp-in (SETTLE_S)
+    estimate_rms_error_in_contact_n: float
+    hand_force_span_in_contact_n: float
+
+
+def summarize(record: BatchRecord, nodes: Mapping[str, Mapping[str, Any]]) -> BatchSummary:
+    """The figures of ``record``, a run of the session ``nodes`` describe."""
+    dev = node_view(nodes, "device_node")
+    law = build(ImpedanceLaw, node_view(nodes, "controller_node"))
+    wall = build(VirtualWall, node_view(nodes, "environment_node"))
+    loop = build(LoopSettings, dev)
+    contact = record.in_contact(wall)
+    return BatchSummary(
+        str(dev.get("model", "slide")),
+        law.mode.value,
+        law.kf,
+        wall.stiffness_n_per_m,
+        build(ObserverSettings, node_view(nodes, "observer_node")).gain,
+        record.t.size / loop.rate_hz,
+        loop.seed,
+        100.0 * contact.share,
+        contact.rms_error_n,
+        contact.span_n,
+    )
