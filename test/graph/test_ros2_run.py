@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import signal
 import subprocess
@@ -204,3 +205,63 @@ def test_a_signal_during_start_up_ends_quietly_with_0(
         if proc.poll() is None:
             proc.kill()
             proc.wait(5)
+
+
+def test_the_container_runs_the_loop_nodes_its_params_file_names(root) -> None:
+    """``ros2 run haptic_dob container --ros-args --params-file FILE``, as the docs write it, runs
+    the nodes the file's sections name (it exited 2, "name at least one node to run")."""
+    exe = Path(get_package_prefix("haptic_dob")) / "lib" / "haptic_dob" / "container"
+    env = isolated_env()
+    config = root / "config" / "slide_sim.yaml"
+    proc = subprocess.Popen(
+        [str(exe), "--ros-args", "--params-file", str(config), "-p", "device_node:duration_s:=0.0"],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+    )
+    out = Output(proc)
+    try:
+        loop = {"device_node", "environment_node", "observer_node", "controller_node"}
+
+        def all_up() -> bool:
+            return proc.poll() is not None or loop <= node_names(env)
+
+        assert wait_until(all_up, 60, poll_s=0.5) and proc.poll() is None, out.text(proc)
+        proc.send_signal(signal.SIGINT)
+        text = out.text(proc)
+        assert proc.returncode == 0, text
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(5)
+
+
+def test_a_bare_p_that_a_node_section_shadows_is_said_with_what_to_type(root) -> None:
+    """``--params-file config/slide_sim.yaml -p clock_mode:=realtime``: the file's device section
+    wins (rcl's order) and the device says so at start-up, with the form that reaches it; typed
+    that way, the device runs in real time."""
+    exe = Path(get_package_prefix("haptic_sim")) / "lib" / "haptic_sim" / "device_node"
+    config = str(root / "config" / "slide_sim.yaml")
+    said: list[str] = []
+    for rule in ("clock_mode:=realtime", "device_node:clock_mode:=realtime"):
+        proc = subprocess.Popen(
+            [str(exe), "--ros-args", "--params-file", config, "-p", rule],
+            env=isolated_env(),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+        )
+        out = Output(proc)
+        try:
+            built = functools.partial(out.has, "simulated slide device")
+            assert wait_until(built, 60, poll_s=0.01), out.text(proc)
+            proc.send_signal(signal.SIGINT)
+            said.append(out.text(proc))
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(5)
+    bare, qualified = said
+    shadow = [line for line in bare.splitlines() if "ignored -p clock_mode:=realtime" in line]
+    assert len(shadow) == 1 and "lockstep" in bare, bare
+    assert "type -p device_node:clock_mode:=realtime after the last --params-file" in shadow[0]
+    assert "realtime at 1000 Hz" in qualified and "ignored" not in qualified, qualified
