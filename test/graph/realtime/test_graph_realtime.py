@@ -21,10 +21,10 @@ def test_realtime_loop_closes_at_rate(root, tmp_path, composed: bool) -> None:
     commands arriving before the next tick is a benchmark (BENCHMARKS.md); the test only asserts
     that the loop closes early (commands for at least 2700 of 3000 ticks, most of them on time)
     and that nothing is refused. Skips where the suite's capacity measurement says this machine
-    cannot turn this loop over fast enough for real time at 1 kHz now: the loop's work in
-    lockstep (``require_realtime``), and in four processes the raw DDS floor of the command's
-    path (device -> environment -> controller -> device: three hops, the slower of just before
-    and just after the run; ``require_hop_floor``), which no node can go under.
+    cannot carry this loop in real time at 1 kHz now: the CPU a cycle costs against what the
+    CPUs give a period (``require_realtime``), and in four processes the raw DDS floor of the
+    command's path (device -> environment -> controller -> device: three hops, the slower of
+    just before and just after the run; ``require_hop_floor``), which no node can go under.
     """
     loop = ["environment_node", "observer_node", "controller_node", "device_node"]
     # four processes: every message between them costs a process wake-up on each side (about

@@ -14,11 +14,11 @@ master's end then goes silent ``timeout`` samples later (20 ms, 21 samples), as 
 does; the slave's end likewise with the master's lag. The upper bound allows ``SLACK`` samples for
 the hand-over and the lag's measurement.
 
-Skips where the suite's capacity measurement says this machine cannot turn the graph over fast
-enough for real time at 1 kHz now (``capacity.require_realtime_teleop``). A process per side
+Skips where the suite's capacity measurement says this machine cannot give a cycle of the graph
+the CPU it costs at 1 kHz now (``capacity.require_realtime_teleop``). A process per side
 (``--group master --group slave``) is not tested here: a stall of one process over the 20 ms
 watchdog makes the other end find its peer silent and then back, before any cut (seen once on
-this machine at a measured capacity over 1.2x).
+this machine when the old lockstep probe measured over 1.2x real time).
 """
 
 from __future__ import annotations
