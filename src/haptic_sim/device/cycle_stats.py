@@ -1,11 +1,12 @@
 """Real-time cycle statistics of a device: commands on time or late, latency, overruns.
 
-Command k is on time when it arrives before the tick that applies it (the plant still at sample
-k); its latency is measured from sample k's send. A tick whose command did not come is late
-(counted once the loop has closed, after the first command). The ticks are due on the wall
-clock's grid (sample 0's time plus whole periods): a tick that runs a period or more after its
-time is an overrun, and the grid points it passed are missed ticks (the plant moves on through
-them). ``CycleStats`` is what a run reports (the ``stats_file`` JSON, ``dataclasses.asdict``).
+Command k is on time when it arrives before the tick that applies it (the plant still at sample k);
+its latency is measured from sample k's send. A tick whose command did not come is late (counted
+once the loop has closed, after the first command). The ticks are due on the wall clock's grid
+(sample 0's time plus whole periods): a tick that runs a period or more after its time is an
+overrun, and the grid points it passed are missed ticks (the simulated plant steps once a tick: a
+missed tick is a period the simulation loses). ``CycleStats`` is what a run reports (the
+``stats_file`` JSON, ``dataclasses.asdict``).
 """
 
 from __future__ import annotations

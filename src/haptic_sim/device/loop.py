@@ -6,12 +6,14 @@
   lags (``RecorderGate``) command k is held; after the last sample the run ends once the recorder
   has written it.
 - realtime: ticks on the wall clock's grid (sample 0's time plus whole periods) once the graph is
-  up and applies the newest valid command; each sample is stamped with the system clock when it
-  is taken, as a hardware driver stamps. A tick that comes a period or more late is an overrun:
-  the plant, which does not wait for its driver, moves on through the periods missed with the
-  command held, and the next tick is again on the grid (time never slows). The watchdog
-  (``CommandWatchdog``) counts the samples the device sent and zeroes the effort when commands
-  stop; ``RealtimeStats`` counts whether command k came before the next tick, and the overruns.
+  up, applies the newest valid command and steps the plant one period; each sample is stamped
+  with the system clock when it is taken, as a hardware driver stamps. A tick that comes a period
+  or more late is an overrun, the grid points it passed are missed ticks (the simulation loses
+  them: catching up would cost a loaded machine more periods still), and the next tick is again
+  on the grid: time never slows, and a run of ``last_k`` periods ends ``last_k`` periods after
+  sample 0. The watchdog (``CommandWatchdog``) counts the samples the device sent and zeroes the
+  effort when commands stop; ``RealtimeStats`` counts whether command k came before the next
+  tick, and the overruns.
 
 Every command passes the ``CommandGuard`` first. The node behind ``LoopPort`` publishes, runs
 deferred work and answers questions about the ROS graph; the loop tells it what to do.
@@ -38,9 +40,6 @@ from haptic_sim.slide.device import SimulatedSlide
 STARTUP_RESEND_S = 0.5  # lockstep: sample 0 again this often until command 0 comes
 GRAPH_POLL_S = 0.05  # how often the start and the end of a run look at the graph again
 WATCHDOG_SAY_EVERY_S = 1.0  # the watchdog says at most a line this often; news waits, never lost
-#: real time: after an overrun the plant moves through at most this long of missed periods (a
-#: process stopped for minutes does not spend as long catching up); the rest it skips
-MAX_CATCH_UP_S = 1.0
 
 
 class LoopPort(Protocol):
@@ -82,7 +81,8 @@ class DeviceLoop:
         log: where the loop says what it does.
         values: the node's parameter values (``settings_for``; ``ValueError`` when refused).
         lockstep: lockstep (True) or real time.
-        last_k: the run ends after publishing this sample (None: never).
+        last_k: the run ends after publishing this sample (in real time: the sample of this grid
+            point; None: never).
         clock_ns: the system clock that stamps a real-time sample (ns).
     """
 
@@ -145,7 +145,7 @@ class DeviceLoop:
         self._news = (
             True,
             f"watchdog: no valid {EFFORT_COMMAND} for {held} (limit {timeout * 1e3:g} ms of "
-            f"simulated time): effort zeroed ({self.watchdog.trips} trips so far)",
+            f"samples sent): effort zeroed ({self.watchdog.trips} trips so far)",
         )
 
     def _say_resumed(self) -> None:
@@ -232,7 +232,8 @@ class DeviceLoop:
         """Publish the current sample; in lockstep arm the re-send and end the run at its end."""
         self.stepped = False
         s = self.device.sample()
-        last = self.last_k is not None and s.k >= self.last_k and not self.recorders.draining
+        at = s.k if self.lockstep else self.grid  # real time: the run lasts its periods
+        last = self.last_k is not None and at >= self.last_k and not self.recorders.draining
         if last:  # the run ends with this sample: a command that answers it moves nothing
             self.recorders.start_drain(time.monotonic())
         self.publish(s)
@@ -243,9 +244,15 @@ class DeviceLoop:
         if last:
             wall = time.monotonic() - self.t_first
             sim = s.k * self.period_ns * 1e-9
+            rt = self.realtime
+            missed = (
+                ""
+                if self.lockstep
+                else f"; {rt.missed_ticks} ticks missed in {rt.overruns} overruns"
+            )
             self.log.info(
                 f"finished: {s.k} cycles ({sim:g} s simulated) in {wall:.2f} s, "
-                f"real-time factor {sim / wall:.2f}"
+                f"real-time factor {sim / wall:.2f}{missed}"
             )
             # stay up (publishers alive) until a recorder has written the last sample
             self.deadline = time.monotonic()
@@ -340,9 +347,8 @@ class DeviceLoop:
         self.deadline = now + timeout_s
 
     def tick(self, now: float) -> None:
-        """Real time: apply the newest valid command (zero when the watchdog trips) over the
-        periods since the last tick, send the next sample, schedule the next tick on the grid
-        (sample 0 on the first)."""
+        """Real time: apply the newest valid command (zero when the watchdog trips), send the
+        next sample, schedule the next tick on the grid (sample 0 on the first)."""
         period = self.period_ns * 1e-9
         if not self.started:
             self.started = True
@@ -356,11 +362,7 @@ class DeviceLoop:
         effort = self.latest
         if self.watchdog.due(self.ticks, self.settings.command_timeout_s):
             effort = self.zero
-        steps = min(grid - self.grid, round(MAX_CATCH_UP_S / period))
-        if self.last_k is not None:
-            steps = min(steps, self.last_k - k)  # the run ends at its last sample
-        for _ in range(steps):  # the held command over every period since the last tick
-            self.advance(effort)
+        self.advance(effort)
         self.grid = grid
         self.ticks += 1
         self.send_sample()

@@ -16,7 +16,8 @@ stamp as ROS time, in both clock modes; these two only while someone reads them)
   (0: never), once a recorder (if any) has written the last sample.
 - realtime: once the ``wait_for`` nodes are up (as in lockstep; ``[]`` starts at once), ticks at
   ``rate_hz`` on the wall clock's grid and applies the newest valid command; a tick a period or
-  more late is an overrun, and the plant moves on through the periods missed (time never slows);
+  more late is an overrun and the grid points it passed are missed ticks (time never slows: a
+  ``duration_s`` run lasts ``duration_s``, with a sample fewer per missed tick);
   records whether command k arrived before the next tick, its latency and the overruns
   (``stats_file``).
 

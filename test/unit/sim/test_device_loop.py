@@ -351,7 +351,7 @@ def test_a_trip_soon_after_another_is_said_late_not_lost() -> None:
     loop.tick(said_at + 1.0)
     assert log.lines[1] == (
         "warning",
-        "watchdog: no valid effort_command for 6 samples (limit 5 ms of simulated time): effort "
+        "watchdog: no valid effort_command for 6 samples (limit 5 ms of samples sent): effort "
         "zeroed (2 trips so far)",
     )
     command(loop, 1.0)
@@ -361,11 +361,12 @@ def test_a_trip_soon_after_another_is_said_late_not_lost() -> None:
 
 def test_realtime_follows_the_wall_clock_and_a_late_tick_does_not_slow_time() -> None:
     """Each sample carries the system clock when it was taken; a tick 3.4 periods late is one
-    overrun, three missed ticks (4, 5, 6), and the plant moves through every period missed with the
-    command held (its sample index is the grid's again); the next tick is due on the grid. The
-    watchdog counts the samples sent, so the device's own stall does not trip it."""
+    overrun and three missed ticks (4, 5, 6), the plant steps one period with the held command,
+    and the next tick is due on the grid again. The watchdog counts the samples sent, so the
+    device's own stall does not trip it. A run of N periods ends at grid point N, however many
+    ticks were missed."""
     clock = Clock()
-    loop, port, _log = started(lockstep=False, clock=clock, wait_for=[])
+    loop, port, log = started(lockstep=False, last_k=9, clock=clock, wait_for=[])
     t0, stamp0 = loop.t_first, clock.now_ns
     assert port.sent[0].stamp_ns == stamp0 == loop.stamp_ns
     t = t0 + 0.001
@@ -380,13 +381,19 @@ def test_realtime_follows_the_wall_clock_and_a_late_tick_does_not_slow_time() ->
     clock.now_ns = stamp0 + 7_400_000
     loop.wakeup(t0 + 0.0074)
     s = port.sent[-1]
-    assert (s.k, s.stamp_ns, s.effort) == (7, clock.now_ns, (2.0,))  # held over [3, 7)
-    assert len(port.sent) == 5 and loop.deadline == pytest.approx(t0 + 0.008)
+    assert (s.k, s.stamp_ns, s.effort) == (4, clock.now_ns, (2.0,))
+    assert loop.grid == 7 and loop.deadline == pytest.approx(t0 + 0.008)
     stats = loop.stats()
-    assert (stats.overruns, stats.missed_ticks, stats.cycles, stats.watchdog_trips) == (1, 3, 7, 0)
+    assert (stats.overruns, stats.missed_ticks, stats.cycles, stats.watchdog_trips) == (1, 3, 4, 0)
     assert stats.commands_on_time == 4 and stats.commands_late == 0
-    command(loop, 3.0)  # labelled with sample 7's stamp: on time
+    command(loop, 3.0)  # labelled with the newest sample's stamp: on time
     assert loop.realtime.on_time == 5
+    for grid in (8, 9):  # the run of 9 periods ends at grid point 9, sample 6
+        clock.now_ns = stamp0 + grid * 1_000_000 + 50_000
+        loop.wakeup(loop.deadline)
+    assert port.sent[-1].k == 6 and loop.recorders.draining
+    assert log.said("finished: 6 cycles (0.006 s simulated)") == 1
+    assert log.said("3 ticks missed in 1 overruns") == 1
 
 
 def test_realtime_shutdown_runs_one_last_period_at_zero_effort() -> None:
