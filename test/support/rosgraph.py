@@ -45,11 +45,15 @@ def random_domains(n: int) -> list[int]:
 
 
 def isolated_env(domain: int | None = None) -> dict[str, str]:
-    """This environment with a random domain id (``random_domain``) and localhost-only
-    discovery."""
+    """This environment with a random domain id (``random_domain``), localhost-only discovery,
+    and the nodes' log lines written as they are said (unbuffered, whichever stream rcutils
+    writes: a test whose evidence is a log line reads it while the process runs, and a
+    ``RCUTILS_LOGGING_USE_STDOUT`` of the caller's would leave lines in a file's block buffer
+    until the process ends, or lose them when it is killed)."""
     env = dict(os.environ)
     env["ROS_DOMAIN_ID"] = str(domain if domain is not None else random_domain())
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    env["RCUTILS_LOGGING_BUFFERED_STREAM"] = "0"
     env.pop("ROS_STATIC_PEERS", None)
     return env
 

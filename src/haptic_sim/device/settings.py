@@ -37,7 +37,8 @@ def device_node_specs() -> list[ParamSpec]:
         ParamSpec(
             "clock_mode",
             "lockstep",
-            "lockstep: advance when command k arrived; realtime: tick at rate_hz",
+            "lockstep: advance when command k arrived (stamps k * T); realtime: tick at rate_hz on "
+            "the wall clock (stamps: the system clock when each sample is taken)",
             choices=CLOCK_MODES,
             read_only=True,
         ),
@@ -52,8 +53,8 @@ def safety_specs() -> list[ParamSpec]:
         ParamSpec(
             "command_timeout_s",
             0.005,
-            "realtime watchdog: zero effort when no valid command came for this long of "
-            "simulated time (samples: a stall of the device's own process does not count)",
+            "realtime watchdog: zero effort when no valid command came for this long, counted in "
+            "the samples the device sent (a stall of the device's own process does not count)",
             "s",
             0.0005,
             1.0,

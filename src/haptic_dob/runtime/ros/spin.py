@@ -44,6 +44,7 @@ from haptic_dob.runtime.cpu_latency import NO_REQUEST, hold, strictest
 from haptic_dob.runtime.cpus import checked_cpus, pin_process
 from haptic_dob.runtime.ros.dds_profile import use_default_profile
 from haptic_dob.runtime.ros.log import LoopLog
+from haptic_dob.runtime.ros_args import shadow_line, shadowed
 from haptic_msgs_py.bus import bus_for
 
 EXECUTORS = ("events", "single")
@@ -157,6 +158,16 @@ def hold_asked_cpu_latency(nodes: Sequence[Node]) -> int | None:
     return fd
 
 
+def say_shadowed(nodes: Sequence[Node], argv: Sequence[str]) -> None:
+    """Each node says, in one line, which ``-p`` values of ``argv`` a params file's section
+    overrode for it, and what to type instead (``haptic_dob.runtime.ros_args``)."""
+    for node in nodes:
+        fqn = node.get_fully_qualified_name()
+        found = shadowed(argv, fqn)
+        if found:
+            node.get_logger().warning(shadow_line(found, fqn))
+
+
 def run_over(nodes: Sequence[LoopNode]) -> bool:
     """Whether the spin loop stops: a node finished with an error or without ending a run of its
     own, or every node that ends its run by itself (``finishes_run``) has finished."""
@@ -192,9 +203,10 @@ def run_nodes(
     kind = executor or os.environ.get("HAPTIC_DOB_EXECUTOR", "events")
     use_default_profile()
     context = Context()
+    argv = list(args) if args is not None else sys.argv
     try:
         rclpy.init(
-            args=list(args) if args is not None else sys.argv,
+            args=argv,
             context=context,
             signal_handler_options=SignalHandlerOptions.NO,
         )
@@ -224,6 +236,7 @@ def run_nodes(
             nodes = list(make_nodes(context))
             pin_to_asked_cpus(nodes)
             latency_fd = hold_asked_cpu_latency(nodes)
+            say_shadowed(nodes, argv)
         except InvalidParameterValueException as exc:
             text = " ".join(str(exc).split())  # "... Reason: <reason>: <name>"
             reason, _, name = (text.partition("Reason: ")[2] or text).rpartition(": ")
