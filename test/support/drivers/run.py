@@ -1,0 +1,129 @@
+"""Start a test driver from a test, work its controls, read its truth.
+
+``start`` writes the driver's config and starts ``drivers/node.py`` as a process of its own
+(``rosgraph.Process``: its own session, stopped by SIGINT, killed if it lingers). ``Controls``
+holds one publisher per test control (transient local, so a message sent before the driver
+matched still arrives): the stylus button, a pause of the state. ``Truth`` reads what the driver
+wrote when it stopped.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from support.rosgraph import Process
+
+NODE = Path(__file__).resolve().parent / "node.py"
+
+#: a hand like slide_sim's: a 2 N push with a slow semi-random swing, held by a soft grip
+SLIDE_HAND = {
+    "behaviour": "semi_random",
+    "mass_kg": 0.1,
+    "stiffness_n_per_m": 300.0,
+    "damping_n_s_per_m": 10.0,
+    "offset_m": 0.0091667,
+    "amplitude_m": 0.0011458,
+    "band_low_hz": 0.05,
+    "band_high_hz": 10.0,
+    "ramp_s": 1.0,
+}
+
+
+def start(cfg: dict[str, Any], env: dict[str, str], directory: Path) -> Process:
+    """The driver of ``cfg`` (``node.py``'s keys; ``out`` defaults to ``directory``), running."""
+    directory.mkdir(parents=True, exist_ok=True)
+    cfg = {"out": str(directory), **cfg}
+    path = directory / "driver.json"
+    path.write_text(json.dumps(cfg))
+    return Process([sys.executable, str(NODE), str(path)], env, directory / "driver.log")
+
+
+class Controls:
+    """The test's hand on a driver: its controls in namespace ``ns`` (a private context)."""
+
+    def __init__(self, env: dict[str, str], ns: str) -> None:
+        import rclpy
+        from rclpy.context import Context
+        from std_msgs.msg import Bool, Float64
+
+        from support.drivers.speak import LATCHED
+
+        self._saved = {
+            k: os.environ.get(k) for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")
+        }
+        os.environ["ROS_DOMAIN_ID"] = env["ROS_DOMAIN_ID"]
+        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = env["ROS_AUTOMATIC_DISCOVERY_RANGE"]
+        self.context = Context()
+        rclpy.init(context=self.context, args=[])
+        self.node = rclpy.create_node(
+            "test_hand", context=self.context, start_parameter_services=False
+        )
+        self._bool, self._float = Bool, Float64
+        self._button = self.node.create_publisher(Bool, f"{ns}/test/button", LATCHED)
+        self._pause = self.node.create_publisher(Float64, f"{ns}/test/pause", LATCHED)
+
+    def press(self, held: bool) -> None:
+        """Hold (or let go of) the stylus's white button."""
+        self._button.publish(self._bool(data=held))
+
+    def pause(self, seconds: float) -> None:
+        """The driver publishes no state for ``seconds``."""
+        self._pause.publish(self._float(data=seconds))
+
+    def close(self) -> None:
+        import rclpy
+
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+        for k, v in self._saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+@dataclass(frozen=True)
+class Truth:
+    """What a driver wrote when it stopped: its counts and plant, and per cycle and command
+    series (``ticks``: stamp ns, q, the effort applied over the period before, hand force (3),
+    tip (3); ``commands``: arrival (monotonic s), the stamp answered, values)."""
+
+    info: dict[str, Any]
+    ticks: np.ndarray
+    commands: np.ndarray
+    dof: int
+
+    @classmethod
+    def read(cls, directory: Path) -> Truth:
+        info = json.loads((directory / "truth.json").read_text())
+        data = np.load(directory / "series.npz")
+        return cls(info, data["ticks"], data["commands"], int(data["dof"]))
+
+    @property
+    def counts(self) -> dict[str, Any]:
+        return dict(self.info["counts"])
+
+    @property
+    def q(self) -> np.ndarray:
+        return self.ticks[:, 1 : 1 + self.dof]
+
+    @property
+    def applied(self) -> np.ndarray:
+        """The effort applied (joints; the Touch's Cartesian force in the model's axes)."""
+        n = 3 if self.info["kind"] == "touch" else self.dof
+        return self.ticks[:, 1 + self.dof : 1 + self.dof + n]
+
+    @property
+    def hand(self) -> np.ndarray:
+        return self.ticks[:, -6:-3]
+
+    @property
+    def tip(self) -> np.ndarray:
+        return self.ticks[:, -3:]
