@@ -92,7 +92,8 @@ class DriverNode(LoopNode):
         self._answered = -1  # the newest stamp a command answered on time
         self.on_time = self.late = self.missed_ticks = self.states = 0
         self.latency = LatencyHistogram()
-        self.ticks: list[tuple[float, ...]] = []  # stamp, q..., effort..., hand (3), tip (3)
+        #: per tick: stamp, monotonic s, published (1/0), q..., effort..., hand (3), tip (3)
+        self.ticks: list[tuple[float, ...]] = []
         self.commands: list[tuple[float, ...]] = []  # arrival (monotonic), stamp, values...
         self.last_command: tuple[float, ...] = ()
 
@@ -126,12 +127,14 @@ class DriverNode(LoopNode):
         stamp = time.time_ns()
         if self.kind == "touch":
             self.io.press(self._button, stamp)
-        if now >= self.paused_until:
+        published = now >= self.paused_until
+        if published:
             self._publish(stamp, s)
         if self.kind == "fd" or self.kind == "arm":
             self._written = self.io.update()  # the controller's update: acts from this tick on
         applied = self._force if self.kind == "touch" else s.effort
-        self.ticks.append((stamp, *s.q, *applied, *s.hand_force, *s.ee_position))
+        row = (stamp, now, float(published), *s.q, *applied, *s.hand_force, *s.ee_position)
+        self.ticks.append(row)
         self.deadline += self.period_s
         if now - self.deadline > self.period_s:
             self.missed_ticks += int((now - self.deadline) / self.period_s)

@@ -92,8 +92,9 @@ class Controls:
 @dataclass(frozen=True)
 class Truth:
     """What a driver wrote when it stopped: its counts and plant, and per cycle and command
-    series (``ticks``: stamp ns, q, the effort applied over the period before, hand force (3),
-    tip (3); ``commands``: arrival (monotonic s), the stamp answered, values)."""
+    series (``ticks``: stamp ns, monotonic s, whether the state went out, q, the effort applied
+    over the period before, hand force (3), tip (3); ``commands``: arrival (monotonic s), the
+    stamp answered, values)."""
 
     info: dict[str, Any]
     ticks: np.ndarray
@@ -111,14 +112,32 @@ class Truth:
         return dict(self.info["counts"])
 
     @property
+    def stamps(self) -> np.ndarray:
+        return self.ticks[:, 0]
+
+    @property
+    def times(self) -> np.ndarray:
+        """Monotonic s of each tick (the test's clock too)."""
+        return self.ticks[:, 1]
+
+    @property
+    def published(self) -> np.ndarray:
+        return self.ticks[:, 2] > 0.5
+
+    @property
     def q(self) -> np.ndarray:
-        return self.ticks[:, 1 : 1 + self.dof]
+        return self.ticks[:, 3 : 3 + self.dof]
 
     @property
     def applied(self) -> np.ndarray:
-        """The effort applied (joints; the Touch's Cartesian force in the model's axes)."""
+        """The effort applied over the period before each tick (joints; the Touch's Cartesian
+        force in the model's axes)."""
         n = 3 if self.info["kind"] == "touch" else self.dof
-        return self.ticks[:, 1 + self.dof : 1 + self.dof + n]
+        return self.ticks[:, 3 + self.dof : 3 + self.dof + n]
+
+    def tick_of(self, stamp_ns: float) -> int:
+        """The index of the tick whose state carried ``stamp_ns``."""
+        return int(np.searchsorted(self.stamps, stamp_ns))
 
     @property
     def hand(self) -> np.ndarray:
