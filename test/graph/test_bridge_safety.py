@@ -47,7 +47,7 @@ def test_loop_command_stops_zero_within_the_timeout_in_driver_states(tmp_path) -
     finally:
         truth = run.finish()
     cmd = truth.commands
-    values, answered = cmd[:, 2:], cmd[:, 1]
+    values, answered = cmd[:, 2:], truth.answered
     pushes = np.flatnonzero(nonzero(values))
     assert len(pushes) >= quiet_after // 2  # it pushed (a loaded machine trips a few zeros)
     last_push = pushes[-1]
@@ -196,7 +196,7 @@ def test_the_clamp_and_the_rate_limit(tmp_path) -> None:
     # also up from a zero; a zero (the stop's, a watchdog's on a loaded machine) is never slowed.
     # Pairs of commands answering consecutive states: the driver's subscription keeps the last
     # 10 and may drop some on a loaded machine
-    ticks = np.array([truth.tick_of(s) for s in truth.commands[:, 1]])
+    ticks = np.array([truth.tick_of(s) for s in truth.answered])
     pairs = (np.diff(ticks) == 1) & nonzero(values[1:])
     assert pairs.sum() >= 300
     assert np.abs(np.diff(values, axis=0))[pairs].max() <= 1.0 + 1e-9

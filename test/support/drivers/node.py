@@ -95,6 +95,8 @@ class DriverNode(LoopNode):
         #: per tick: stamp, monotonic s, published (1/0), q..., effort..., hand (3), tip (3)
         self.ticks: list[tuple[float, ...]] = []
         self.commands: list[tuple[float, ...]] = []  # arrival (monotonic), stamp, values...
+        self.tick_stamps: list[int] = []  # each tick's stamp, exact (ns)
+        self.answered: list[int] = []  # the stamp each command answers, exact (-1: none)
         self.last_command: tuple[float, ...] = ()
 
     # --- inputs ------------------------------------------------------------------------------
@@ -102,6 +104,7 @@ class DriverNode(LoopNode):
         now = time.monotonic()
         self.last_command = values
         self.commands.append((now, float(-1 if stamp_ns is None else stamp_ns), *values))
+        self.answered.append(-1 if stamp_ns is None else stamp_ns)
         if stamp_ns == self._stamp and self._answered != self._stamp:
             self._answered = self._stamp
             self.on_time += 1
@@ -135,6 +138,7 @@ class DriverNode(LoopNode):
         applied = self._force if self.kind == "touch" else s.effort
         row = (stamp, now, float(published), *s.q, *applied, *s.hand_force, *s.ee_position)
         self.ticks.append(row)
+        self.tick_stamps.append(stamp)
         self.deadline += self.period_s
         if now - self.deadline > self.period_s:
             self.missed_ticks += int((now - self.deadline) / self.period_s)
@@ -199,6 +203,8 @@ class DriverNode(LoopNode):
             out / "series.npz",
             ticks=np.array(self.ticks, dtype=np.float64),
             commands=np.array(self.commands, dtype=np.float64),
+            tick_stamps=np.array(self.tick_stamps, dtype=np.int64),
+            answered=np.array(self.answered, dtype=np.int64),
             dof=self.plant.dof,
         )
 

@@ -100,20 +100,25 @@ class Truth:
     ticks: np.ndarray
     commands: np.ndarray
     dof: int
+    stamps: np.ndarray  # each tick's stamp (ns, int64)
+    answered: np.ndarray  # the stamp each command answers (ns, int64; -1: none)
 
     @classmethod
     def read(cls, directory: Path) -> Truth:
         info = json.loads((directory / "truth.json").read_text())
         data = np.load(directory / "series.npz")
-        return cls(info, data["ticks"], data["commands"], int(data["dof"]))
+        return cls(
+            info,
+            data["ticks"],
+            data["commands"],
+            int(data["dof"]),
+            data["tick_stamps"],
+            data["answered"],
+        )
 
     @property
     def counts(self) -> dict[str, Any]:
         return dict(self.info["counts"])
-
-    @property
-    def stamps(self) -> np.ndarray:
-        return self.ticks[:, 0]
 
     @property
     def times(self) -> np.ndarray:
@@ -135,7 +140,13 @@ class Truth:
         n = 3 if self.info["kind"] == "touch" else self.dof
         return self.ticks[:, 3 + self.dof : 3 + self.dof + n]
 
-    def tick_of(self, stamp_ns: float) -> int:
+    def ticked_share(self) -> float:
+        """The driver's ticks over the periods of its life: 1 when it held its rate (a Python
+        test driver on a loaded machine falls behind, which a real driver would not)."""
+        periods = (self.times[-1] - self.times[0]) * float(self.info["rate_hz"])
+        return (len(self.times) - 1) / periods if periods > 0 else 0.0
+
+    def tick_of(self, stamp_ns: int) -> int:
         """The index of the tick whose state carried ``stamp_ns``."""
         return int(np.searchsorted(self.stamps, stamp_ns))
 
