@@ -5,7 +5,7 @@ raises."""
 from __future__ import annotations
 
 import os
-from typing import Any
+from typing import Any, ClassVar
 
 import pytest
 
@@ -26,7 +26,7 @@ class Raising(LoopNode):
 class Zeroing(LoopNode):
     """A loop node that records its shutdown (a bridge sending zero)."""
 
-    shut: list[str] = []
+    shut: ClassVar[list[str]] = []
 
     def on_shutdown(self) -> None:
         Zeroing.shut.append(self.get_name())
