@@ -48,6 +48,9 @@ class BridgeRun:
             "wait_for": ["controller_node"],
             "start_delay_s": 0.2,
             "stats_file": str(self.stats),
+            # a Python test driver beside a CPU hog stalls for more than 10 ms now and then:
+            # 50 ms keeps the state watchdog for the test that stops the state
+            "state.timeout_s": 0.05,
             **overrides,
         }
         params = bridge_params(FD_CONFIG, settings, directory)
