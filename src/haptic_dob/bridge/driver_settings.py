@@ -21,6 +21,7 @@ COMMAND_TYPES = ("float64_multi_array", "wrench_stamped", "wrench", "vector3")
 RELIABILITY = ("reliable", "best_effort")
 VELOCITY_SOURCES = ("auto", "driver", "difference")
 EFFORT_SOURCES = ("commanded", "driver")
+STAMP_SOURCES = ("driver", "receipt")
 
 #: each profile's command type, driver cycles before a command acts, and effort source
 PROFILE_DEFAULTS: dict[str, tuple[str, int, str]] = {
@@ -61,6 +62,15 @@ class StateSettings:
         ),
     )
     depth: int = field(default=10, metadata=param("queue depth of the subscription", "", 1, 1000))
+    stamp: str = field(
+        default="driver",
+        metadata=param(
+            "the stamp the loop's samples carry: the driver's header stamp, or the system clock "
+            "when the state arrives (receipt: for a driver whose stamps are zero or do not "
+            "advance)",
+            choices=STAMP_SOURCES,
+        ),
+    )
     joints: list[str] | tuple[str, ...] = field(
         default_factory=lambda: [""],
         metadata=param(

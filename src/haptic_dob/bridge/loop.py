@@ -111,14 +111,23 @@ class BridgeLoop:
         self.latency = LatencyHistogram()  # s, state arrival -> its command sent
         self.states = self.on_time = self.late = 0
         self.refused = self.dropped = self.gated = self.zeros = 0
-        self.state_trips = self.deadman_releases = 0
+        self.state_trips = self.deadman_releases = self.repeated = 0
 
     # --- the driver's state --------------------------------------------------------------
     def on_state(self, s: DriverState, now: float) -> tuple[LoopSample | None, Send | None]:
         """Driver state ``s`` arrived at monotonic ``now`` (s): the loop's sample (None while
         not handing on) and a zero to send first (None when none is due)."""
-        if self.stopping or s.stamp_ns <= self.newest_ns:
-            return None, None  # after the stop, or a stamp that did not advance: not a new state
+        if self.stopping:
+            return None, None
+        if s.stamp_ns <= self.newest_ns:  # a stamp that did not advance: not a new state
+            self.repeated += 1
+            if self.repeated == 1:
+                self._say(
+                    "the driver's state stamps do not advance (a state stamped "
+                    f"{s.stamp_ns} after {self.newest_ns}): such states are not handed on; "
+                    "state.stamp: receipt stamps them on arrival"
+                )
+            return None, None
         self.states += 1
         self.state_deadline = now + self.state_timeout_s
         if self.state_stale:
@@ -263,4 +272,5 @@ class BridgeLoop:
             "watchdog_trips": self.watchdog.trips,
             "state_trips": self.state_trips,
             "deadman_releases": self.deadman_releases,
+            "states_not_advancing": self.repeated,
         }

@@ -103,6 +103,7 @@ class BridgeNode(LoopNode):
             event_callbacks=PublisherEventCallbacks(incompatible_qos=self._mismatch(c.topic)),
         ).publish
         self._decode: Any = (codecs.POSE if self.reader.pose else codecs.JOINT_STATE).decoder()
+        self._on_receipt = s.stamp == "receipt"
         self.create_subscription(
             rclpy_type(STATE_TYPENAMES[s.type]),
             s.topic,
@@ -162,10 +163,11 @@ class BridgeNode(LoopNode):
         now = time.monotonic()
         try:
             m = self._decode(data)
+            stamp = time.time_ns() if self._on_receipt else m.stamp_ns
             if self.reader.pose:
-                state = self.reader.position(m.stamp_ns, m.vector)
+                state = self.reader.position(stamp, m.vector)
             else:
-                state = self.reader.joints(m.stamp_ns, m.name, m.position, m.velocity, m.effort)
+                state = self.reader.joints(stamp, m.name, m.position, m.velocity, m.effort)
             sample, zero = self.loop.on_state(state, now)
         except ValueError as exc:
             if str(exc) != self._bad_state:  # once per distinct problem, not at 1 kHz

@@ -145,3 +145,16 @@ def test_late_commands_are_counted_per_state() -> None:
     assert b.on_command(cmd(2), 0.0025) is not None  # late, still newer than the last answered
     assert (b.on_time, b.late) == (1, 1)
     assert b.counts()["on_time_pct"] == pytest.approx(50.0)
+
+
+def test_states_whose_stamps_do_not_advance_are_said_once_and_counted() -> None:
+    said: list[str] = []
+    driver = DriverSettings.of({"state.topic": "s", "command.topic": "c"})
+    safety = SafetySettings(command_limits=[5.0]).check()
+    b = BridgeLoop(driver, safety, model(), FD, 1000.0, said.append)
+    b.start()
+    b.on_state(state(0), 0.0)  # a driver that leaves its stamps at zero
+    for _ in range(3):
+        assert b.on_state(state(0), 0.0) == (None, None)
+    assert b.counts()["states_not_advancing"] == 3
+    assert len([s for s in said if "do not advance" in s]) == 1
