@@ -21,7 +21,6 @@ import time
 from typing import Any
 
 from rclpy.context import Context
-from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 
 from haptic_dob.bridge.driver_settings import DriverSettings
 from haptic_dob.bridge.loop import BridgeLoop, Send
@@ -43,8 +42,8 @@ from haptic_msgs_py.driver_wire import (
     deadman_reader,
 )
 from haptic_msgs_py.ros import qos
+from haptic_msgs_py.ros.driver_io import driver_publisher, driver_subscription
 from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
-from haptic_msgs_py.ros.raw import rclpy_type
 from haptic_msgs_py.topics import EE_POSE, EE_TWIST, EFFORT_COMMAND, EFFORT_ESTIMATE, JOINT_STATES
 from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
 
@@ -96,31 +95,18 @@ class BridgeNode(LoopNode):
         # the driver's side: its own types, topics and QoS; a QoS mismatch is said, not silent
         c, s = driver.command, driver.state
         self._encode = command_encoder(c.type, c.frame_id or base)
-        self._send_bytes = self.create_publisher(
-            rclpy_type(COMMAND_TYPENAMES[c.type]),
-            c.topic,
-            qos.driver(c.reliability, c.depth),
-            event_callbacks=PublisherEventCallbacks(incompatible_qos=self._mismatch(c.topic)),
-        ).publish
+        say = self._mismatch
+        typename = COMMAND_TYPENAMES[c.type]
+        self._send_bytes = driver_publisher(self, typename, c.topic, c.reliability, c.depth, say)
         self._decode: Any = (codecs.POSE if self.reader.pose else codecs.JOINT_STATE).decoder()
         self._on_receipt = s.stamp == "receipt"
-        self.create_subscription(
-            rclpy_type(STATE_TYPENAMES[s.type]),
-            s.topic,
-            self._on_state,
-            qos.driver(s.reliability, s.depth),
-            raw=True,
-            event_callbacks=SubscriptionEventCallbacks(incompatible_qos=self._mismatch(s.topic)),
-        )
+        typename = STATE_TYPENAMES[s.type]
+        driver_subscription(self, typename, s.topic, self._on_state, s.reliability, s.depth, say)
         if safety.deadman != "none":
             self._held = deadman_reader(safety.deadman, safety.deadman_button)
-            self.create_subscription(
-                rclpy_type(DEADMAN_TYPENAMES[safety.deadman]),
-                safety.deadman_topic,
-                self._on_deadman,
-                qos.driver(safety.deadman_reliability, 10),
-                raw=True,
-            )
+            typename, topic = DEADMAN_TYPENAMES[safety.deadman], safety.deadman_topic
+            reliability = safety.deadman_reliability
+            driver_subscription(self, typename, topic, self._on_deadman, reliability, 10, say)
         if self.run.external_torque_topic:  # the estimate in the driver's names, after the command
             topic = self.run.external_torque_topic
             self._p_ext = LoopPublisher(self, topic, codecs.JOINT_STATE, qos.LOOP, base)
@@ -148,15 +134,8 @@ class BridgeNode(LoopNode):
         if self.reader.pose:
             check_cartesian(self.model)
 
-    def _mismatch(self, topic: str) -> Any:
-        def say(event: Any) -> None:
-            self.log.error(
-                f"{topic}: a peer's QoS is incompatible ({event.last_policy_kind.name}), nothing "
-                "passes between them: check state.reliability / command.reliability",
-                throttle_duration_sec=5.0,
-            )
-
-        return say
+    def _mismatch(self, text: str) -> None:
+        self.log.error(text, throttle_duration_sec=5.0)
 
     # --- the cycle: driver state -> loop -> driver command ------------------------------------
     def _on_state(self, data: bytes) -> None:
