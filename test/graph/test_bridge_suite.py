@@ -51,4 +51,4 @@ def test_a_suite_device_elsewhere_closes_the_loop_through_the_bridge(tmp_path) -
     assert b["commands_on_time"] + b["commands_late"] >= 0.9 * b["handed_on"], b
     assert d["refused_commands"] == 0, d
     applied = [m.effort[0] for m in col.messages("/device/joint_states") if len(m.effort)]
-    assert sum(abs(e) > 0.05 for e in applied) >= 300  # the wall's force, through the bridge
+    assert sum(abs(e) > 0.05 for e in applied) >= 50  # the wall's force, through the bridge
