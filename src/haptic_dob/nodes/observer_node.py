@@ -144,7 +144,7 @@ class ObserverNode(LoopNode):
         self._force = estimate(self.observer, q, qd, tau)
         self._publish(now)  # the estimate first, then what is said of it
         self.diagnostics.tick()
-        if round(jump) != 1:  # a driver's stamps (the system clock) jitter within a period
+        if jump != 1.0:
             self.gaps += 1
             self.log.warning(
                 f"joint_states jumped {jump:g} periods ({self.gaps} gaps so far); the update "
