@@ -32,6 +32,8 @@ def test_a_suite_device_elsewhere_closes_the_loop_through_the_bridge(tmp_path) -
         tmp_path / "device.log",
         extra=["--only", "device_node", "--namespace", "/device"],
     )
+    # the device ticks before the loop starts (its start-up may take seconds on a loaded machine)
+    assert col.wait_for("/device/joint_states", 1, 120.0), device.output()
     graph = launch(
         str(ROOT / "config" / "bridge_suite.yaml"),
         env,
