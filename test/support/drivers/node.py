@@ -39,6 +39,7 @@ from haptic_msgs_py.stamps import period_ns
 from support.drivers import plants
 from support.drivers.speak import LATCHED, Ros2Control, Touch
 
+TICKING = "ticking"  # the driver's first line once it ticks (``run.start`` waits for it)
 ARM_JOINTS = tuple(f"joint{i}" for i in range(1, 8))
 GRIPPER = "gripper_finger_joint"  # an extra joint the arm's model does not have
 FD_JOINTS = ("fd_x", "fd_y", "fd_z")
@@ -121,6 +122,8 @@ class DriverNode(LoopNode):
         return self.deadline
 
     def on_wakeup(self, now: float) -> None:
+        if self._k < 0:
+            self.get_logger().info(f"{TICKING} at {self.cfg['rate_hz']} Hz")
         if self._k >= 0:
             if self._answered != self._stamp and self.on_time:
                 self.late += 1

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from support.rosgraph import Process
+from support.waits import wait_until
 
 NODE = Path(__file__).resolve().parent / "node.py"
 
@@ -37,12 +38,19 @@ SLIDE_HAND = {
 
 
 def start(cfg: dict[str, Any], env: dict[str, str], directory: Path) -> Process:
-    """The driver of ``cfg`` (``node.py``'s keys; ``out`` defaults to ``directory``), running."""
+    """The driver of ``cfg`` (``node.py``'s keys; ``out`` defaults to ``directory``), ticking
+    (its start-up may take seconds on a loaded machine: a session started before would run
+    without it)."""
     directory.mkdir(parents=True, exist_ok=True)
     cfg = {"out": str(directory), **cfg}
     path = directory / "driver.json"
     path.write_text(json.dumps(cfg))
-    return Process([sys.executable, str(NODE), str(path)], env, directory / "driver.log")
+    proc = Process([sys.executable, str(NODE), str(path)], env, directory / "driver.log")
+    if not wait_until(lambda: "ticking" in proc.output() or proc.proc.poll() is not None, 120.0):
+        proc.stop()
+        raise TimeoutError(f"the test driver did not start ticking:\n{proc.output()[-2000:]}")
+    assert proc.proc.poll() is None, proc.output()[-2000:]
+    return proc
 
 
 class Controls:
