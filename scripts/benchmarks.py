@@ -18,6 +18,7 @@ from pathlib import Path
 # bench_timer_floor (the machine's own stalls), bench_margin (the graph against its floors)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_batch import bench_batch_session, bench_observer_update
+from bench_bridge import bench_bridge
 from bench_graph import (
     GRAPH_ARGS,
     bench_lockstep,
@@ -63,6 +64,7 @@ BENCHMARKS: dict[str, Callable[[int], str]] = {
     "margin": bench_margin,
     "realtime-margin": bench_realtime_margin,
     "log": bench_log,
+    "bridge": bench_bridge,
 }
 
 

@@ -130,6 +130,7 @@ class Collector:
     the device sends sample 0 only once it has matched and a lockstep device waits for it when a
     loaded machine leaves it behind, instead of running past the publishers' history
     (``back_pressure=False`` turns that off, e.g. for topics that stop while the loop goes on).
+    ``best_effort=True`` subscribes to everything best effort, as a sensor-data reader does.
     """
 
     def __init__(
@@ -139,6 +140,7 @@ class Collector:
         name: str = "collector",
         namespace: str = "",
         back_pressure: bool = True,
+        best_effort: bool = False,
     ) -> None:
         import rclpy
         from rclpy.context import Context
@@ -188,6 +190,8 @@ class Collector:
                         count.wrote(read(data), 1_000_000)
 
             qos = RECORD if topic in SESSION_TOPICS else volatile
+            if best_effort:  # as a sensor-data reader takes them (ext_observer_ros, say)
+                qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
             self._subs[topic] = self.node.create_subscription(
                 rclpy_type(typename), topic, cb, qos, raw=True
             )

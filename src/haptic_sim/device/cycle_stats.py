@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from haptic_sim.device.latency import LatencyHistogram
+from haptic_dob.runtime.latency import LatencyHistogram
 
 
 @dataclass(frozen=True)

@@ -40,7 +40,7 @@ from typing import Any
 
 from rclpy.context import Context
 
-from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.common import main_for, missing_nodes
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
@@ -67,7 +67,6 @@ from haptic_sim.device.sample import DeviceSample
 from haptic_sim.device.settings import (
     DeviceLoopSettings,
     device_node_specs,
-    missing_nodes,
     start_topics,
 )
 

@@ -415,7 +415,7 @@ def test_wait_for_names_a_node_here_or_anywhere_by_its_full_name() -> None:
     """A plain ``wait_for`` name is a node of the device's namespace; ``/rosbag2_recorder``
     (``ros2 bag record``'s node, in the root namespace) waits for a recorder of a namespaced
     session."""
-    from haptic_sim.device.settings import missing_nodes
+    from haptic_dob.nodes.common import missing_nodes
 
     graph = [("controller_node", "/slide1"), ("rosbag2_recorder", "/"), ("probe", "/lab/a")]
     wait_for = ["controller_node", "/rosbag2_recorder", "/lab/a/probe"]
