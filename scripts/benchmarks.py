@@ -1,7 +1,8 @@
 """Benchmarks of the suite (not timed tests): each prints medians over repeated runs.
 
 Usage: ``.venv/bin/python scripts/benchmarks.py [NAME ...] [--repeat N]``; without names, all
-in-process benchmarks run. BENCHMARKS.md records the figures with the exact command and machine.
+run, one line each. ``make bench`` (``bench_tables.py``) runs them as BENCHMARKS.md's rows give
+them and rewrites those rows with the figures, the machine and the date.
 """
 
 from __future__ import annotations

@@ -146,8 +146,8 @@ class Collector:
         from rclpy.context import Context
         from rclpy.experimental import EventsExecutor
 
+        from haptic_dob.bag.cdr import stamp_reader
         from haptic_dob.recorder.counts import RecordingCounts
-        from haptic_dob.recorder.topics import stamp_reader
         from haptic_msgs_py.ros.qos import CLOCK, RECORD
         from haptic_msgs_py.ros.raw import rclpy_type
         from haptic_msgs_py.topics import RECORDER_PROGRESS, SESSION_TOPICS

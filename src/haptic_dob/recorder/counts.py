@@ -28,6 +28,7 @@ class TopicCount:
     gaps: int = 0  # stamps missing between consecutive written messages (stamped topics)
     first_ns: int | None = None  # smallest stamp written
     newest_ns: int | None = None  # largest stamp written
+    durable_ns: int | None = None  # largest stamp written when the bag was last made durable
 
     def wrote(self, stamp_ns: int | None, period_ns: int) -> None:
         """Count a written message stamped ``stamp_ns`` (None: none); the loop period (ns)
