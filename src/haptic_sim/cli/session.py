@@ -7,7 +7,6 @@ import json
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from haptic_dob.cli.common import ArgumentParser, run
 from haptic_dob.core.control import ControlMode
@@ -15,9 +14,10 @@ from haptic_dob.core.environment import VirtualWall
 from haptic_dob.core.validation import nonnegative, positive
 from haptic_dob.runtime.configs import resolve_config
 from haptic_dob.runtime.params import load_node_params, node_view
+from haptic_sim.arm.session import ArmSessionConfig, ArmSessionSummary, run_arm_session
 from haptic_sim.device.batch import BatchSummary, load_session, run_batch, summarize
 from haptic_sim.hand import reference_for_force
-from haptic_sim.slide.session import SessionConfig, run_session
+from haptic_sim.slide.session import SessionConfig, SessionSummary, run_session
 from haptic_sim.slide.stability import law_for
 
 
@@ -36,12 +36,10 @@ def command(
     model = node_view(load_node_params(path), "device_node").get("model", "slide")
     if model == "point_mass":
         overrides = Overrides(controller, kf, stiffness, duration, seed)
-        figures = dataclasses.asdict(run_cartesian(path, overrides, save))
-        print_summary({**figures, "saved": save} if save else figures, as_json)
+        print_summary(run_cartesian(path, overrides, save), save, as_json)
         return 0
     if model != "slide":
-        summary = run_arm(path, controller, kf, stiffness, duration, seed, save)
-        print_summary(summary, as_json)
+        print_summary(run_arm(path, controller, kf, stiffness, duration, seed, save), save, as_json)
         return 0
     cfg = SessionConfig.from_yaml(path)
     if controller is not None or kf is not None:
@@ -61,11 +59,9 @@ def command(
     if seed is not None:
         cfg = cfg.replace(loop__seed=int(nonnegative("--seed", seed)))
     result = run_session(cfg)
-    summary = result.summary()
     if save:
         result.save(save)
-        summary["saved"] = save
-    print_summary(summary, as_json)
+    print_summary(result.summary(), save, as_json)
     return 0
 
 
@@ -77,10 +73,8 @@ def run_arm(
     duration: float | None,
     seed: int | None,
     save: str | None,
-) -> dict[str, Any]:
+) -> ArmSessionSummary:
     """A PHANToM or URDF-arm session (``haptic_sim.arm.session``) with the same overrides."""
-    from haptic_sim.arm.session import ArmSessionConfig, run_arm_session
-
     cfg = ArmSessionConfig.from_yaml(path)
     if controller is not None or kf is not None:
         law = cfg.law
@@ -99,11 +93,9 @@ def run_arm(
     if seed is not None:
         cfg = cfg.replace(loop__seed=int(nonnegative("--seed", seed)))
     result = run_arm_session(cfg)
-    summary = result.summary()
     if save:
         result.save(save)
-        summary["saved"] = save
-    return summary
+    return result.summary()
 
 
 @dataclass(frozen=True)
@@ -141,8 +133,13 @@ def run_cartesian(path: Path, o: Overrides, save: str | None) -> BatchSummary:
     return summarize(record, nodes)
 
 
-def print_summary(summary: dict[str, Any], as_json: bool) -> None:
-    """JSON, or one aligned ``key  value`` line per figure."""
+def print_summary(
+    figures: SessionSummary | ArmSessionSummary | BatchSummary, saved: str | None, as_json: bool
+) -> None:
+    """JSON, or one aligned ``key  value`` line per figure (and where the arrays went)."""
+    summary: dict[str, object] = dict(dataclasses.asdict(figures))
+    if saved:
+        summary["saved"] = saved
     if as_json:
         print(json.dumps(summary, indent=2))
         return
