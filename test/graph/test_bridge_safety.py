@@ -141,9 +141,12 @@ def test_deadman_released_zero_at_once(tmp_path) -> None:
     held = cmd[(cmd[:, 0] > t_held) & (cmd[:, 0] < t_released)]
     assert nonzero(held[:, 2:]).sum() >= 100
     after = cmd[cmd[:, 0] > t_released]
-    first_zero = np.flatnonzero(~nonzero(after[:, 2:]))[0]
-    assert not nonzero(after[first_zero:, 2:]).any()
-    assert first_zero <= 100, first_zero  # pushes in flight at the release, then zero
+    # pushes in flight at the release (a watchdog zero may come between them on a loaded
+    # machine), then zero for good
+    pushes = np.flatnonzero(nonzero(after[:, 2:]))
+    settled = int(pushes[-1]) + 1 if len(pushes) else 0
+    assert settled <= 100, settled
+    assert len(after) - settled >= 150, "too few commands after the release to tell"
     assert truth.info["last_command"] == [0.0, 0.0, 0.0]
     assert run.counts()["deadman_releases"] == 1
 
