@@ -34,6 +34,7 @@ import tempfile
 from pathlib import Path
 
 from haptic_dob.cli.common import ArgumentParser, run
+from haptic_dob.launcher import robot_description
 from haptic_dob.launcher.node_params import (
     add_command_tokens,
     add_cpu_latency,
@@ -68,6 +69,11 @@ def command(opts: LaunchOptions) -> int:
         return teleop_command(opts, load_teleop_sections(path))
     namespace = normalize_namespace(opts.namespace)
     params = resolved_params(path, parse_sets(opts.sets))
+    if opts.robot_description:
+        urdf = robot_description.fetch(
+            opts.robot_description, network_env(opts.network, opts.peers)
+        )
+        robot_description.fill(params, urdf)
     if opts.record:
         add_recorder(params, opts.record, opts.record_storage)
     names = select([n for n in START_ORDER if n in params], opts.only)
@@ -190,6 +196,12 @@ def build_parser() -> ArgumentParser:
         "poll, which speeds up every hand-over (BENCHMARKS.md) and costs power; on a virtual "
         "machine only 0 helps",
     )
+    p.add_argument(
+        "--robot-description",
+        metavar="TOPIC",
+        help="read the URDF a driver latches on TOPIC (robot_state_publisher's "
+        "robot_description) and give it to every node whose model is urdf",
+    )
     return p
 
 
@@ -214,6 +226,7 @@ def parse_options(argv: list[str] | None = None) -> LaunchOptions:
         rt_priority=a.rt_priority,
         pin=a.pin,
         cpu_latency_us=a.cpu_latency,
+        robot_description=a.robot_description,
     )
 
 

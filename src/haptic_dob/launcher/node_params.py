@@ -16,12 +16,16 @@ import yaml
 from haptic_dob.core.command_authority import new_token
 from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import NODES
+from haptic_dob.runtime.configs import urdf_beside
 from haptic_dob.runtime.params import load_node_params
 
 
 def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """The config's node sections (flattened, ``--set`` applied), keyed by node name."""
+    """The config's node sections (flattened, ``--set`` applied), keyed by node name; a
+    relative ``urdf_path`` is taken from the config's directory where the file is there
+    (``urdf/fd_cartesian.urdf`` beside an installed config)."""
     out = load_node_params(config)
+    urdf_beside(out, config)
     unknown = [n for n in out if n != "/**" and n not in NODES]
     if unknown:
         raise InputError(
@@ -39,7 +43,8 @@ def add_recorder(params: dict[str, Any], output: str, storage: str) -> None:
             f"--record {output}: it exists already; the recorder never overwrites a bag"
         )
     params.setdefault("recorder_node", {}).update(output=output, storage=storage)
-    device = params.setdefault("device_node", {})
+    # the node that starts the loop waits for it: the bridge to a driver, or the device
+    device = params.setdefault("bridge_node" if "bridge_node" in params else "device_node", {})
     wait = list(device.get("wait_for", ["environment_node", "observer_node", "controller_node"]))
     if "recorder_node" not in wait:
         device["wait_for"] = [*wait, "recorder_node"]

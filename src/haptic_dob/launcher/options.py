@@ -39,6 +39,7 @@ class LaunchOptions:
     rt_priority: int | None = None
     pin: bool = False
     cpu_latency_us: int | None = None
+    robot_description: str | None = None
 
 
 def comma_list(text: str) -> tuple[str, ...]:

@@ -30,6 +30,7 @@ from haptic_dob.errors import InputError
 from haptic_dob.launcher.node_params import add_command_tokens
 from haptic_dob.launcher.options import LaunchOptions, network_env, say_session
 from haptic_dob.launcher.process_plan import ProcessSpec, executable
+from haptic_dob.launcher.robot_description import fetch, fill
 from haptic_dob.launcher.supervise import launch, set_rt_priority
 from haptic_dob.nodes.registry import CONTAINER, NODES
 from haptic_dob.teleop.graph import (
@@ -37,6 +38,7 @@ from haptic_dob.teleop.graph import (
     RECORDER,
     SIDE_NODES,
     check_sections,
+    device_of,
     graph_nodes,
     node_values,
     recorded_topics,
@@ -57,7 +59,7 @@ def teleop_params(
         check_sections(sections)
     except ValueError as exc:
         raise InputError(str(exc)) from None
-    out = {f"{ns}/{node}": node_values(sections, ns, node) for ns, node in graph_nodes()}
+    out = {f"{ns}/{node}": node_values(sections, ns, node) for ns, node in graph_nodes(sections)}
     for item in sets:
         target, sep, assignment = item.partition(":")
         param, eq, text = assignment.partition("=")
@@ -76,7 +78,8 @@ def teleop_params(
         for name in names:
             out[name][param] = value
     for ns in NAMESPACES:  # a real-time side's channel end uses what has come (no lockstep wait)
-        if out[f"{ns}/device_node"].get("clock_mode") == "realtime":
+        device = device_of(sections, ns)  # a bridge to a driver is real time
+        if device != "device_node" or out[f"{ns}/{device}"].get("clock_mode") == "realtime":
             out[f"{ns}/channel_node"].setdefault("wait_for_peer", False)
     out["slave/device_node"].setdefault("command_source", SLAVE_SOURCE)
     return out
@@ -108,10 +111,13 @@ def add_teleop_recorder(params: dict[str, dict[str, Any]], output: str, storage:
         "storage": storage,
         "topics": recorded_topics(),
         "namespaces": [f"/{ns}" for ns in NAMESPACES],
-        "rate_hz": params["master/device_node"].get("rate_hz", 1000.0),
+        "rate_hz": params.get("master/device_node", params.get("master/bridge_node", {})).get(
+            "rate_hz", 1000.0
+        ),
     }
     for ns in NAMESPACES:
-        device = params[f"{ns}/device_node"]
+        name = f"{ns}/device_node" if f"{ns}/device_node" in params else f"{ns}/bridge_node"
+        device = params[name]
         default = [n for n in SIDE_NODES[ns] if n != "device_node"]
         device["wait_for"] = [*device.get("wait_for", default), RECORDER]
 
@@ -200,6 +206,9 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
             "/master and /slave)"
         )
     params = teleop_params(sections, opts.sets)
+    if opts.robot_description:
+        env = network_env(opts.network, opts.peers)
+        fill(params, fetch(opts.robot_description, env))
     names = select_nodes([n for n in params if "/" in n], opts.only)
     groups = teleop_groups(names, opts.composed, opts.processes, opts.groups)
     if opts.record and opts.only:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 from haptic_dob.runtime.params import ParamSpec
 from haptic_msgs_py.topics import DEFAULT_BASE_FRAME, INPUT_RELIABILITY
 
@@ -187,3 +189,17 @@ def main_for(node_class: type, args: list[str] | None, specs: list[ParamSpec]) -
 
     ensure_ament_prefix()
     return run_nodes(lambda ctx: [node_class(context=ctx)], argv)
+
+
+def missing_nodes(
+    wait_for: Iterable[str], graph: Iterable[tuple[str, str]], namespace: str
+) -> list[str]:
+    """The ``wait_for`` entries that are not up in ``graph`` ((name, namespace) of each node): a
+    plain name is a node of ``namespace``, one starting with ``/`` a fully qualified name (a
+    recorder elsewhere, such as ``ros2 bag record``'s ``/rosbag2_recorder``)."""
+    here, everywhere = set(), set()
+    for name, space in graph:
+        everywhere.add(f"{space.rstrip('/')}/{name}")
+        if space == namespace:
+            here.add(name)
+    return [w for w in wait_for if w not in (everywhere if w.startswith("/") else here)]

@@ -33,7 +33,7 @@ from rclpy.context import Context
 
 from haptic_dob.core.command_authority import new_token
 from haptic_dob.core.command_join import FALLBACKS, CommandJoin
-from haptic_dob.core.control import ImpedanceController, ImpedanceLaw
+from haptic_dob.core.control import HandForce, ImpedanceController, ImpedanceLaw
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.factory import build_model, model_specs
 from haptic_dob.nodes.common import (
@@ -138,9 +138,9 @@ class ControllerNode(LoopNode):
         ]
         warm = values["warm_inputs"]
         start_need = self.join.law.needs
-        if warm or start_need == "measured":
+        if warm or start_need is HandForce.MEASURED:
             inputs.append((WRENCH_MEASURED, codecs.WRENCH, self._on_measured))
-        if warm or start_need == "estimated":
+        if warm or start_need is HandForce.ESTIMATED:
             inputs.append((WRENCH_ESTIMATE, codecs.WRENCH, self._on_estimated))
         if self.join.needs_q:
             inputs.append((JOINT_STATES, codecs.JOINT_STATE, self._on_joint_states))

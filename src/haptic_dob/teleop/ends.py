@@ -28,7 +28,7 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 from haptic_dob.core.control import ZERO_FORCE, Force, limit_norm
-from haptic_dob.teleop.delay import DelayLine, _quiet
+from haptic_dob.teleop.delay import DelayLine, SampleClock, _quiet
 from haptic_dob.teleop.passivity import PassivityPort
 from haptic_dob.teleop.settings import ChannelSettings, TeleopSettings
 
@@ -85,6 +85,7 @@ class _End:
         self.period_ns = period_ns
         self.dt = period_ns * 1e-9
         self.line: DelayLine[PortMessage] = DelayLine(channel, period_ns, salt, lost, back)
+        self.clock = SampleClock(period_ns)  # this side's sample indices
         self.port = PassivityPort(self.dt, channel.passivity)
         self.origin: Vec3 | None = None  # the side's point at its first sample (m)
         self.peer_silent = False
@@ -95,7 +96,7 @@ class _End:
 
     def ready(self, stamp_ns: int) -> bool:
         """Lockstep: every message that can be due by this sample has come."""
-        return self.line.complete(stamp_ns // self.period_ns)
+        return self.line.complete(self.clock.index(stamp_ns))
 
     def _incoming(self, k: int) -> PortMessage | None:
         """The newest message due by sample ``k``, None while the peer is silent."""
@@ -156,7 +157,7 @@ class MasterEnd(_End):
         disp = (position[0] - o[0], position[1] - o[1], position[2] - o[2])
         x = _rotate(self._R, t.position_scale, disp)
         v = _rotate(self._R, t.position_scale, velocity)
-        msg = self._incoming(stamp_ns // self.period_ns)
+        msg = self._incoming(self.clock.index(stamp_ns))
         if msg is None:
             f: Force = ZERO_FORCE
             if self.peer_silent:  # its force comes back over the ramp
@@ -213,7 +214,7 @@ class SlaveEnd(_End):
         to track and the message to the master."""
         if self.origin is None:
             self.origin = self.target = position
-        msg = self._incoming(stamp_ns // self.period_ns)
+        msg = self._incoming(self.clock.index(stamp_ns))
         if self.peer_silent:
             if not self.holding:  # hold where it is
                 self.holding = True

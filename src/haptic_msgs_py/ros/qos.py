@@ -79,3 +79,18 @@ RECORD = QoSProfile(
     reliability=ReliabilityPolicy.RELIABLE,
     durability=DurabilityPolicy.VOLATILE,
 )
+
+
+def driver(reliability: str, depth: int) -> QoSProfile:
+    """A foreign driver's topic as the bridge meets it: keep-last ``depth``, volatile,
+    ``reliable`` or ``best_effort`` (a best-effort reader matches both kinds of writer; a
+    reliable writer serves both kinds of reader)."""
+    kind = (
+        ReliabilityPolicy.RELIABLE if reliability == "reliable" else ReliabilityPolicy.BEST_EFFORT
+    )
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST,
+        depth=depth,
+        reliability=kind,
+        durability=DurabilityPolicy.VOLATILE,
+    )

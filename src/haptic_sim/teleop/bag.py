@@ -109,6 +109,11 @@ def session_config(events: list[Any], shown: str) -> TeleopConfig:
         if ns in NAMESPACES:
             declared = sections.setdefault(e.node, {})
             declared.update({k: v for k, v in e.values.items() if k in e.new})
+    if any(v.get("clock_mode") == "realtime" for v in sections.values()):
+        raise BagError(
+            f"{shown}: a real-time recording (each side stamped by its own system clock): the "
+            "two sides' samples cannot be paired by stamp; record the session in lockstep"
+        )
     wanted = [f"/{ns}/{n}" for ns in NAMESPACES for n in SIDE_NODES[ns]]
     missing = [w for w in wanted if w not in sections]
     if missing:

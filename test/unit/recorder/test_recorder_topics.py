@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import pytest
 
-from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
+from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns, stamp_reader
 from haptic_dob.recorder.settings import DEFAULT_TOPICS
 from haptic_dob.recorder.topics import (
     PARAMETER_EVENT_TYPE,
     TopicEntry,
     TopicKind,
     parse_topics,
-    stamp_reader,
 )
 from haptic_msgs_py import wire
 from haptic_msgs_py.stamps import command_label

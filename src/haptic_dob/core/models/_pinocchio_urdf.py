@@ -154,3 +154,15 @@ def urdf_model(
     damping = tuple(float(model.damping[i]) for i in idx_v)
     friction = tuple(float(model.friction[i]) for i in idx_v)
     return UrdfArm(model, frame_id(model, tip_frame), tuple(wanted), S, limits, damping, friction)
+
+
+def add_payload(model: pin.Model, frame: int, mass_kg: float) -> None:
+    """Put a point mass of ``mass_kg`` (kg, >= 0) at frame ``frame``'s origin, on the body that
+    carries it (a handle, a tool, a sensor the URDF does not have). Before any ``Data``."""
+    if not (math.isfinite(mass_kg) and mass_kg >= 0.0):
+        raise ValueError(f"payload_kg must be finite and >= 0, got {mass_kg!r}")
+    if mass_kg == 0.0:
+        return
+    f = model.frames[frame]
+    point = pin.Inertia(float(mass_kg), f.placement.translation.copy(), np.zeros((3, 3)))
+    model.appendBodyToJoint(f.parentJoint, point, pin.SE3.Identity())
