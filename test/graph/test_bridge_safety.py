@@ -17,8 +17,9 @@ import numpy as np
 import pytest
 from std_msgs.msg import Bool
 
-from support.drivers.bridge_run import BridgeRun
+from support.drivers.bridge_run import NS, BridgeRun
 from support.drivers.run import Controls
+from support.drivers.stand_in import LoopStandIn
 from support.waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess]
@@ -217,3 +218,24 @@ def test_the_clamp_and_the_rate_limit(tmp_path) -> None:
     assert np.abs(np.diff(values, axis=0))[pairs].max() <= 1.0 + 1e-9
     counts = run.counts()
     assert counts["clamped_commands"] > 100 and counts["rate_limited_commands"] > 10
+
+
+def test_a_stray_publisher_moves_nothing_through_the_bridge(tmp_path) -> None:
+    """Command authority at the bridge: the loop's controller (its commands carry the session's
+    token) pushes; a second publisher of effort_command in the same namespace answers the same
+    samples with another force, as a stray ros2 topic pub would: it is refused and named once,
+    and nothing of its force reaches the driver."""
+    stray_push = (2.5, 0.0, 0.0)
+    run = BridgeRun(tmp_path, lambda k: PUSH)
+    stray = LoopStandIn(run.env, NS, lambda k: stray_push, name="stray_pub")
+    try:
+        started(run, 300)
+        assert stray.wait_samples(300, WAIT_S), run.bridge.output()
+    finally:
+        stray.close()
+        truth = run.finish()
+    values = truth.commands[:, 2:]
+    assert nonzero(values).sum() >= 100, "the loop did not push"
+    assert not np.isclose(values[:, 0], stray_push[0]).any(), "a stray command reached the driver"
+    out = run.bridge.output()
+    assert out.count(f"refused effort_command from {NS}/stray_pub") == 1, out

@@ -27,6 +27,8 @@ def test_a_suite_device_elsewhere_closes_the_loop_through_the_bridge(tmp_path) -
             "device_node:clock_mode=realtime",
             "device_node:wait_for=[]",
             "device_node:duration_s=0",
+            # its commands come from the bridge, which labels them with no command token
+            "device_node:open_command_input=true",
             f"device_node:stats_file={tmp_path / 'device.json'}",
         ],
         tmp_path / "device.log",

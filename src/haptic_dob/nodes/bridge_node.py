@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 import time
 from typing import Any
@@ -28,7 +29,16 @@ from haptic_dob.bridge.settings import RunSettings, SafetySettings, bridge_specs
 from haptic_dob.bridge.start import StartGate
 from haptic_dob.bridge.state import StateReader, check_cartesian
 from haptic_dob.core.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import input_specs, loop_specs, main_for, missing_nodes, process_specs
+from haptic_dob.nodes.command_input import CommandInput
+from haptic_dob.nodes.common import (
+    command_authority_specs,
+    input_specs,
+    loop_specs,
+    main_for,
+    missing_nodes,
+    process_specs,
+)
+from haptic_dob.runtime.discovery import exposure_warning
 from haptic_dob.runtime.params import ParamSpec, build
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
@@ -53,6 +63,7 @@ def bridge_node_specs() -> list[ParamSpec]:
     return [
         *loop_specs(),
         *input_specs("reliable"),
+        *command_authority_specs(),
         *process_specs(),
         *model_specs(),
         *bridge_specs(),
@@ -91,7 +102,8 @@ class BridgeNode(LoopNode):
         self._p_js = LoopPublisher(self, JOINT_STATES, codecs.JOINT_STATE, qos.LOOP, base)
         self._names = tuple(self.model.joint_names)
         inputs = qos.loop_input(v["input_reliability"])
-        self._bus = LoopSubscription(self, EFFORT_COMMAND, codecs.EFFORT, self.admit, inputs).bus
+        self._commands = CommandInput(self, self.admit, inputs, v)
+        self._bus = self._commands.bus
         # the driver's side: its own types, topics and QoS; a QoS mismatch is said, not silent
         c, s = driver.command, driver.state
         self._encode = command_encoder(c.type, c.frame_id or base)
@@ -120,6 +132,9 @@ class BridgeNode(LoopNode):
             f"command {c.topic} ({c.type}, {c.reliability}), model {v['model']} "
             f"{list(self._names)}" + (f"; not commanded: {list(unsent)}" if unsent else "")
         )
+        exposed = exposure_warning(os.environ)
+        if exposed:
+            self.log.warning(exposed)
 
     def _check_topics(self, driver: DriverSettings) -> None:
         """The driver's topics are not the loop's own (a loop in the driver's namespace)."""
@@ -168,7 +183,7 @@ class BridgeNode(LoopNode):
         self._say()
 
     def admit(self, cmd: EffortCommand) -> None:
-        """Every command from the loop comes through here (the place for command authority)."""
+        """Every command the command authority lets through (the loop's own controller's)."""
         self._send(self.loop.on_command(cmd, time.monotonic()))
 
     def _send(self, send: Send | None) -> None:
@@ -227,8 +242,13 @@ class BridgeNode(LoopNode):
         values = {
             k: (f"{x:.2f}" if isinstance(x, float) else x) for k, x in self.loop.counts().items()
         }
+        values.update(self._commands.report())
         why = self.loop.status()
-        return (WARN, f"{why}: zero command", values) if why else (OK, "running", values)
+        if why:
+            return WARN, f"{why}: zero command", values
+        if self._commands.refusing():
+            return WARN, "refused commands from a publisher not the loop's", values
+        return OK, "running", values
 
     def on_shutdown(self) -> None:
         """Zero to the driver first (acknowledged before the process ends, when reliable)."""

@@ -10,6 +10,7 @@ truth.
 from __future__ import annotations
 
 import json
+import secrets
 from pathlib import Path
 from typing import Any
 
@@ -44,7 +45,9 @@ class BridgeRun:
         self.directory = directory
         self.env = isolated_env()
         self.stats = directory / "bridge.json"
+        token = secrets.token_hex(8)  # as haptic-launch writes it for a device end and its source
         settings = {
+            "command_token": token,
             "wait_for": ["controller_node"],
             "start_delay_s": 0.2,
             "stats_file": str(self.stats),
@@ -55,7 +58,7 @@ class BridgeRun:
         }
         params = bridge_params(FD_CONFIG, settings, directory)
         self.driver = start({"kind": "fd", "rate_hz": 1000.0}, self.env, directory / "fd")
-        self.loop = LoopStandIn(self.env, NS, answer)
+        self.loop = LoopStandIn(self.env, NS, answer, token)
         argv = [str(BIN / "haptic-bridge-node"), "--ros-args", "--params-file", str(params)]
         argv += ["-r", f"__ns:={NS}"]
         self.bridge = Process(argv, self.env, directory / "bridge.log")

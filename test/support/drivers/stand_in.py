@@ -2,8 +2,9 @@
 
 A node of the test's own (private context, its own thread) subscribes to the loop's
 ``joint_states`` in a namespace and answers each sample with ``effort_command`` labelled with
-its stamp, the values ``answer(k)`` gives (None: no answer), or sends whatever the test asks
-(``send``). It counts the samples it saw, so a test waits in samples, never in milliseconds.
+its stamp and the session's command token, the values ``answer(k)`` gives (None: no answer),
+or sends whatever the test asks (``send``). It counts the samples it saw, so a test waits in
+samples, never in milliseconds.
 """
 
 from __future__ import annotations
@@ -21,7 +22,14 @@ Answer = Callable[[int], Sequence[float] | None]
 class LoopStandIn:
     """The loop of namespace ``ns`` as far as the bridge sees it: samples in, commands out."""
 
-    def __init__(self, env: dict[str, str], ns: str, answer: Answer) -> None:
+    def __init__(
+        self,
+        env: dict[str, str],
+        ns: str,
+        answer: Answer,
+        token: str = "",
+        name: str = "controller_node",
+    ) -> None:
         import rclpy
         from rclpy.context import Context
         from rclpy.experimental import EventsExecutor
@@ -38,9 +46,10 @@ class LoopStandIn:
         self.context = Context()
         rclpy.init(context=self.context, args=[])
         self.node = rclpy.create_node(
-            "controller_node", namespace=ns, context=self.context, start_parameter_services=False
+            name, namespace=ns, context=self.context, start_parameter_services=False
         )
         self.answer = answer
+        self.token = token  # the session's command token its commands carry (as a controller's)
         self._lock = threading.Lock()
         self.samples: list[Any] = []  # JointSample values, in arrival order
         self._decode = codecs.JOINT_STATE.decoder()
@@ -75,10 +84,11 @@ class LoopStandIn:
             self.send(js.stamp_ns, values)
 
     def send(self, stamp_ns: int | None, values: Sequence[float]) -> None:
-        """An ``effort_command`` for the sample stamped ``stamp_ns`` (None: unlabelled)."""
+        """An ``effort_command`` for the sample stamped ``stamp_ns`` (None: unlabelled), with the
+        stand-in's command token."""
         from haptic_msgs_py.values import EffortCommand
 
-        self._pub.publish(self._encode(EffortCommand(stamp_ns, tuple(values))))
+        self._pub.publish(self._encode(EffortCommand(stamp_ns, tuple(values), self.token)))
 
     def count(self) -> int:
         """Samples seen so far."""
