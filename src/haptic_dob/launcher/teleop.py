@@ -53,8 +53,8 @@ def teleop_params(
 ) -> dict[str, dict[str, Any]]:
     """``{"master/device_node": {param: value}, ...}`` for every node, ``--set`` applied; a side
     whose device runs in real time gets ``wait_for_peer: false`` on its channel end unless given
-    (waiting for the peer's messages is lockstep's), and the slave's device takes its commands
-    from the slave controller unless told otherwise."""
+    (waiting for the peer's messages is lockstep's), and the slave's device end (its device or
+    bridge) takes its commands from the slave controller unless told otherwise."""
     try:
         check_sections(sections)
     except ValueError as exc:
@@ -81,7 +81,7 @@ def teleop_params(
         device = device_of(sections, ns)  # a bridge to a driver is real time
         if device != "device_node" or out[f"{ns}/{device}"].get("clock_mode") == "realtime":
             out[f"{ns}/channel_node"].setdefault("wait_for_peer", False)
-    out["slave/device_node"].setdefault("command_source", SLAVE_SOURCE)
+    out[f"slave/{device_of(sections, 'slave')}"].setdefault("command_source", SLAVE_SOURCE)
     return out
 
 

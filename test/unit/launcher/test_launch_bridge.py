@@ -37,6 +37,7 @@ def test_a_teleoperation_side_with_a_bridge_in_its_devices_place(root: Path) -> 
     assert list(params)[-2:] == ["master/device_node", "slave/bridge_node"]
     assert params["slave/bridge_node"]["duration_s"] == 2
     assert params["slave/channel_node"]["wait_for_peer"] is False  # a driver is real time
+    assert params["slave/bridge_node"]["command_source"] == "slave_controller_node"
     add_teleop_recorder(params, str(root / "no-such-bag"), "mcap")
     assert params["slave/bridge_node"]["wait_for"][-1] == RECORDER
 
