@@ -320,6 +320,13 @@ class SimulatedArm:
         """Simulated time of the current sample (s)."""
         return self._k * self.dt
 
+    @property
+    def coulomb_speeds(self) -> list[float]:
+        """The speed (rad/s or m/s) over which the plant turns each joint's Coulomb friction,
+        ``Fc tanh(q' / eps)``: the simulator's smoothing at its physics step ([] without Coulomb
+        friction). Part of the plant's truth: an identification finds it as ``v_c``."""
+        return [] if self._coulomb is None else self._coulomb_eps.tolist()
+
     def kinetic_energy(self) -> float:
         """``q'^T D q' / 2`` (J) of the arm's true state (the hand's mass not included)."""
         D, _ = self._dyn(self.q, self.v)

@@ -6,15 +6,20 @@ and ``series.npz`` (per cycle: stamp, positions, the effort applied, the true ha
 per command: arrival, the state answered, values) into the config's ``out`` directory.
 
 Config keys: ``kind`` (``fd``, ``touch``, ``arm``), ``rate_hz``, ``seed``, ``out``, ``hand``
-(``HandParams`` fields), ``hand_axis`` (fd), ``hand_direction`` (touch), ``button`` (touch: the
-white button held from the start), ``table_z`` (arm). Test controls in the driver's namespace:
-``test/pause`` (``std_msgs/Float64``: publish no state for that many seconds, the plant and the
-commands going on) and ``test/button`` (``std_msgs/Bool``, touch: the white button).
+(``HandParams`` fields), ``hand_direction`` (fd, touch: the push's unit vector in the base
+frame), ``button`` (touch: the white button held from the start), ``table_z`` (arm). Test
+controls in the driver's namespace: ``test/pause`` (``std_msgs/Float64``: publish no state for
+that many seconds, the plant and the commands going on) and ``test/button``
+(``std_msgs/Bool``, touch: the white button).
 
 The cycle is the driver's: at tick k+1 the plant moves over [k, k+1) with the effort in force
 (ros2_control: the command written at tick k; Touch: the newest force, on arrival), then state
-k+1 goes out stamped with the system clock. Command k is on time when it answers state k and
-arrives before tick k+1.
+k+1 goes out stamped with its instant on the system clock: the first tick's time plus k+1
+periods. The plant moves exactly one period a tick, so that stamp is the instant its positions
+are true, as a real driver's stamp is the instant it read its device (the tick's own wall time
+would carry the Python driver's jitter into every difference of positions over stamps, which a
+real device does not have). Command k is on time when it answers state k and arrives before
+tick k+1.
 """
 
 from __future__ import annotations
@@ -43,8 +48,6 @@ TICKING = "ticking"  # the driver's first line once it ticks (``run.start`` wait
 ARM_JOINTS = tuple(f"joint{i}" for i in range(1, 8))
 GRIPPER = "gripper_finger_joint"  # an extra joint the arm's model does not have
 FD_JOINTS = ("fd_x", "fd_y", "fd_z")
-#: the Touch driver's axes against the model's base: driver (x, y, z) = model (x, z, -y)
-TOUCH_FROM_MODEL = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 
 
 class DriverNode(LoopNode):
@@ -56,17 +59,19 @@ class DriverNode(LoopNode):
         self.cfg = cfg
         rate = float(cfg["rate_hz"])
         seed = int(cfg.get("seed", 0))
-        self.period_s = period_ns(rate) * 1e-9
+        self.period_ns = period_ns(rate)
+        self.period_s = self.period_ns * 1e-9
         hand = cfg.get("hand", {"behaviour": "none"})
         ns = {"fd": "/fd", "touch": "/touch", "arm": "/arm"}[self.kind]
         self.plant: Any
+        direction = tuple(cfg.get("hand_direction", (0.0, 0.0, -1.0)))
         if self.kind == "fd":
-            self.plant = plants.cartesian_slides(rate, seed, hand, int(cfg.get("hand_axis", 0)))
+            self.plant = plants.point_mass(rate, seed, hand, direction)
             self.io: Any = Ros2Control(self, ns, "fd_controller", FD_JOINTS, FD_JOINTS, self._got)
             self.names = FD_JOINTS
         elif self.kind == "arm":
             self.plant = plants.arm7(rate, seed, float(cfg.get("table_z", 0.39)))
-            assert self.plant.arm.model.joint_names == ARM_JOINTS
+            assert self.plant.model.joint_names == ARM_JOINTS
             shuffled = [*ARM_JOINTS, GRIPPER]
             random.Random(seed).shuffle(shuffled)
             self.names = tuple(shuffled)
@@ -74,8 +79,7 @@ class DriverNode(LoopNode):
             pub = self.create_publisher(String, f"{ns}/robot_description", LATCHED)
             pub.publish(String(data=(plants.ROOT / "config" / "urdf" / "arm7.urdf").read_text()))
         else:
-            direction = tuple(cfg.get("hand_direction", (0.0, 0.0, -1.0)))
-            self.plant = plants.phantom(rate, seed, hand, direction)
+            self.plant = plants.touch(rate, seed, hand, direction)
             self.io = Touch(self, ns, self._got)
             self.names = Touch.JOINTS
             raw_subscription(
@@ -84,10 +88,11 @@ class DriverNode(LoopNode):
         raw_subscription(self, "std_msgs/msg/Float64", f"{ns}/test/pause", self._on_pause, LATCHED)
         self._button = bool(cfg.get("button", False))
         self._written = tuple(0.0 for _ in range(self.plant.dof))  # effort in force (plant joints)
-        self._force = np.zeros(3)  # touch: the Cartesian force in force (model axes)
+        self._force = np.zeros(3)  # touch: the Cartesian force in force (base frame)
         self.deadline = time.monotonic() + 0.2
         self.paused_until = 0.0
         self._k = -1
+        self._t0_ns = 0  # the system clock at the first tick: sample 0's instant
         self._stamp = 0  # the newest state's stamp
         self._t_sent = 0.0
         self._answered = -1  # the newest stamp a command answered on time
@@ -130,7 +135,9 @@ class DriverNode(LoopNode):
             self.plant.apply(self._effort())
         self._k += 1
         s = self.plant.sample()
-        stamp = time.time_ns()
+        if self._k == 0:
+            self._t0_ns = time.time_ns()
+        stamp = self._t0_ns + self._k * self.period_ns
         if self.kind == "touch":
             self.io.press(self._button, stamp)
         published = now >= self.paused_until
@@ -169,7 +176,8 @@ class DriverNode(LoopNode):
             by_name = dict(zip(self.io.command_joints, self._written, strict=True))  # gravity
             g = self.plant.gravity()  # compensation
             return tuple(by_name[n] + gi for n, gi in zip(ARM_JOINTS, g, strict=True))
-        F = TOUCH_FROM_MODEL.T @ np.asarray(self.io.gated_force)  # model axes
+        # the drivers' force_feedback is in their pose frame, the URDF's base frame (speak.py)
+        F = np.array(self.io.gated_force)
         norm = float(np.linalg.norm(F))
         if norm > plants.TOUCH_MAX_FORCE_N:
             F *= plants.TOUCH_MAX_FORCE_N / norm

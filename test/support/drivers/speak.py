@@ -10,10 +10,13 @@
   timeout: ros2_controllers #95).
 - ``Touch``: a community Geomagic Touch driver (AleBarte/Geomagic_Touch_ROS2_Drivers), here at
   500 Hz with ``SensorDataQoS`` as the Touch X driver publishes: ``<ns>/joint_states`` with
-  positions only (waist, shoulder, elbow and the gimbal), the stylus buttons as ``sensor_msgs/
-  Joy`` on change (grey, white), and ``<ns>/force_feedback`` (``WrenchStamped``, reliable, in
-  the driver's own axes) applied only while the white button is held, on arrival (the device's
-  servo loop), clamped to the device's maximum force.
+  positions only (waist, shoulder, elbow and the gimbal, named and signed as ``omni_state.cpp``
+  publishes them: config/urdf/phantom_omni.urdf's joints), the stylus buttons as ``sensor_msgs/
+  Joy`` on change (grey, white), and ``<ns>/force_feedback`` (``WrenchStamped``, reliable)
+  applied only while the white button is held, on arrival (the device's servo loop), clamped to
+  the device's maximum force. The force is in the driver's pose frame: ``omni_state_main.cpp``
+  maps the force to the device's axes with the inverse of the map it gives the position
+  (docs/devices.md has the lines), so it is phantom_omni.urdf's base frame, no axis map.
 """
 
 from __future__ import annotations
