@@ -32,7 +32,7 @@ RUN_S = 10.0
 PROFILES = {
     "fd": (
         "bridge_forcedimension.yaml",
-        {"kind": "fd", "rate_hz": 1000.0, "hand": SLIDE_HAND, "hand_axis": 0},
+        {"kind": "fd", "rate_hz": 1000.0, "hand": SLIDE_HAND, "hand_direction": [1, 0, 0]},
     ),
     "touch": (
         "bridge_touch.yaml",

@@ -64,7 +64,7 @@ def test_external_joint_torques_in_the_drivers_names(tmp_path) -> None:
         assert list(m.name) == ["waist", "shoulder", "elbow"]
         assert len(m.position) == 0 and len(m.velocity) == 0 and len(m.effort) == 3
         same = ours.get(m.header.stamp.sec * 10**9 + m.header.stamp.nanosec)
-        if same is not None:  # the model's names, the same values (signs +1 in this config)
-            assert list(same.name) == ["phi1", "phi2", "phi3"]
+        if same is not None:  # the same values (the URDF's names are the driver's, signs +1)
+            assert list(same.name) == ["waist", "shoulder", "elbow"]
             assert list(m.effort) == pytest.approx(list(same.effort))
     assert any(abs(e) > 1e-3 for m in ext for e in m.effort)

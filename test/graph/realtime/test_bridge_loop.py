@@ -104,7 +104,7 @@ def test_forcedimension_loop_closes_at_1khz_and_renders_the_wall(tmp_path) -> No
     """forcedimension_ros2-like: joint_states fd_x, fd_y, fd_z, Float64MultiArray commands; the
     hand pushes +x into the 800 N/m wall at x = 0."""
     hops = premise(1000.0)
-    driver = {"kind": "fd", "rate_hz": 1000.0, "hand": SLIDE_HAND, "hand_axis": 0}
+    driver = {"kind": "fd", "rate_hz": 1000.0, "hand": SLIDE_HAND, "hand_direction": [1, 0, 0]}
     truth, counts = run_session(tmp_path, driver, "bridge_forcedimension.yaml", [])
     hops.append(hop_floor_us())
     require_hop_floor(2, max(hops))
@@ -115,8 +115,9 @@ def test_forcedimension_loop_closes_at_1khz_and_renders_the_wall(tmp_path) -> No
 
 def test_touch_loop_closes_at_500hz_and_renders_the_wall(tmp_path) -> None:
     """Touch-like: position-only best-effort joint_states at 500 Hz, a WrenchStamped force in
-    the driver's axes, applied only while the stylus's white button is held (the bridge's
-    dead-man too); the hand pushes down into the 400 N/m wall 5 mm below the home point."""
+    the driver's pose frame (the URDF's base frame), applied only while the stylus's white
+    button is held (the bridge's dead-man too); the hand pushes down into the 400 N/m floor
+    5 mm below the stylus's start."""
     hops = premise(500.0)
     hand = {**SLIDE_HAND, "offset_m": 0.012}
     driver = {"kind": "touch", "rate_hz": 500.0, "hand": hand, "hand_direction": [0, 0, -1]}
@@ -124,7 +125,7 @@ def test_touch_loop_closes_at_500hz_and_renders_the_wall(tmp_path) -> None:
     hops.append(hop_floor_us())
     require_hop_floor(2, max(hops), 500.0)
     closes(truth, counts, 500.0)
-    depth = -0.226 - truth.tip[:, 2]
+    depth = -0.0817 - truth.tip[:, 2]  # bridge_touch.yaml's floor
     ratio = rendered(depth, -truth.hand[:, 2], 400.0)
     assert 0.7 < ratio < 1.3, ratio
     assert counts["deadman_releases"] == 0 and counts["gated_commands"] < 0.05 * counts["handed_on"]

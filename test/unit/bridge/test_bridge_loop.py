@@ -11,16 +11,15 @@ from haptic_dob.bridge.driver_settings import DriverSettings
 from haptic_dob.bridge.loop import BridgeLoop
 from haptic_dob.bridge.settings import SafetySettings
 from haptic_dob.bridge.state import DriverState
-from haptic_dob.core.models.urdf import UrdfModel
+from haptic_dob.core.models.point_mass import PointMassModel
 from haptic_msgs_py.values import EffortCommand
-from support.paths import ROOT
 
 FD = ("fd_x", "fd_y", "fd_z")
 T = 1_000_000  # ns: 1 kHz
 
 
-def model() -> UrdfModel:
-    return UrdfModel(ROOT / "config" / "urdf" / "fd_cartesian.urdf", "fd_tip", gravity=False)
+def model() -> PointMassModel:
+    return PointMassModel(0.2, 1.5, 0.1)  # a Force Dimension handle (J = I)
 
 
 def bridge(delay: int = 0, **safety: object) -> BridgeLoop:
