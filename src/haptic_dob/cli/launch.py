@@ -34,6 +34,7 @@ import tempfile
 from pathlib import Path
 
 from haptic_dob.cli.common import ArgumentParser, run
+from haptic_dob.errors import InputError
 from haptic_dob.launcher import robot_description
 from haptic_dob.launcher.node_params import (
     add_command_tokens,
@@ -66,9 +67,12 @@ def command(opts: LaunchOptions) -> int:
     path = resolve_config(opts.config)
     sections = load_sections(path)
     if is_teleop(sections):
+        if opts.overlays:
+            raise InputError("--params lays a file over a one-device config, not a teleoperation")
         return teleop_command(opts, load_teleop_sections(path))
     namespace = normalize_namespace(opts.namespace)
-    params = resolved_params(path, parse_sets(opts.sets))
+    overlays = [resolve_config(o) for o in opts.overlays]
+    params = resolved_params(path, parse_sets(opts.sets), overlays)
     if opts.robot_description:
         urdf = robot_description.fetch(
             opts.robot_description, network_env(opts.network, opts.peers)
@@ -120,6 +124,14 @@ def build_parser() -> ArgumentParser:
         metavar="NODE,NODE[,...]",
         help="these nodes share a process (repeatable; nodes in no group run alone; for a "
         "teleoperation graph: master, slave or NS/NODE)",
+    )
+    p.add_argument(
+        "--params",
+        action="append",
+        default=[],
+        metavar="FILE",
+        help="lay this ros__parameters file over the config (repeatable, in order, before "
+        "--set): a model haptic-identify wrote, an excitation like excite/forcedimension",
     )
     p.add_argument(
         "--set",
@@ -212,6 +224,7 @@ def parse_options(argv: list[str] | None = None) -> LaunchOptions:
         config=a.config,
         namespace=a.namespace,
         sets=tuple(a.set),
+        overlays=tuple(a.params),
         composed=a.composed,
         processes=a.processes,
         groups=tuple(a.group),

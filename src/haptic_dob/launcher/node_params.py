@@ -20,17 +20,27 @@ from haptic_dob.runtime.configs import urdf_beside
 from haptic_dob.runtime.params import load_node_params
 
 
-def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """The config's node sections (flattened, ``--set`` applied), keyed by node name; a
-    relative ``urdf_path`` is taken from the config's directory where the file is there
-    (``urdf/fd_cartesian.urdf`` beside an installed config)."""
-    out = load_node_params(config)
-    urdf_beside(out, config)
-    unknown = [n for n in out if n != "/**" and n not in NODES]
-    if unknown:
-        raise InputError(
-            f"{config} names unknown node(s) {', '.join(unknown)}; known: {', '.join(NODES)}"
-        )
+def resolved_params(
+    config: Path, sets: dict[str, dict[str, Any]], overlays: Sequence[Path] = ()
+) -> dict[str, Any]:
+    """The config's node sections (flattened), each ``overlays`` file's laid over them in order
+    (``--params``: an identified model, an excitation), then ``--set``; keyed by node name. A
+    relative ``urdf_path`` is taken from its file's directory where the file is there
+    (``urdf/phantom_omni.urdf`` beside an installed config)."""
+    out: dict[str, Any] = {}
+    for path in (config, *overlays):
+        try:
+            sections = load_node_params(path)
+        except (OSError, ValueError) as exc:
+            raise InputError(f"{path}: {exc}") from None
+        urdf_beside(sections, path)
+        unknown = [n for n in sections if n != "/**" and n not in NODES]
+        if unknown:
+            raise InputError(
+                f"{path} names unknown node(s) {', '.join(unknown)}; known: {', '.join(NODES)}"
+            )
+        for node, values in sections.items():
+            out.setdefault(node, {}).update(values)
     for node, values in sets.items():
         out.setdefault(node, {}).update(values)
     return out

@@ -25,6 +25,7 @@ class LaunchOptions:
     config: str
     namespace: str = ""
     sets: Sequence[str] = ()
+    overlays: Sequence[str] = ()
     composed: bool = False
     processes: bool = False
     groups: Sequence[str] = ()

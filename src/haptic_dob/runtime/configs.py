@@ -24,14 +24,16 @@ def config_dir() -> Path:
 
 
 def resolve_config(name_or_path: str | Path) -> Path:
-    """A path that exists, or the installed config of that name (``slide_sim`` or ``.yaml``)."""
+    """A path that exists, or the installed config of that name (``slide_sim`` or ``.yaml``;
+    ``excite/touch`` in a folder of the config directory)."""
     p = Path(name_or_path)
     if p.is_file():
         return p
     name = p.name if p.suffix in (".yaml", ".yml") else f"{p.name}.yaml"
-    candidate = config_dir() / name
-    if candidate.is_file():
-        return candidate
+    inside = [] if p.is_absolute() else [config_dir() / p.parent / name]
+    for candidate in (*inside, config_dir() / name):
+        if candidate.is_file():
+            return candidate
     if p.exists():
         raise InputError(f"{p} is not a file")
     available = ", ".join(sorted(f.stem for f in config_dir().glob("*.yaml")))

@@ -14,6 +14,7 @@ from haptic_dob.launcher.process_plan import groups_for
 from haptic_dob.launcher.robot_description import fill
 from haptic_dob.launcher.teleop import add_teleop_recorder, teleop_params
 from haptic_dob.nodes.registry import START_ORDER
+from haptic_dob.runtime.configs import config_dir, resolve_config
 from haptic_dob.teleop.graph import RECORDER, load_teleop_sections
 
 
@@ -24,11 +25,36 @@ def test_the_bridge_is_composed_with_the_loop_and_starts_last(root: Path) -> Non
     assert groups_for(names, False, False, ()) == [
         ["bridge_node", "environment_node", "observer_node", "controller_node"]
     ]
-    # a relative urdf_path is the config's neighbour, whatever the working directory
-    assert params["/**"]["urdf_path"] == str(root / "config" / "urdf" / "fd_cartesian.urdf")
+    assert params["/**"]["model"] == "point_mass"
     add_recorder(params, str(root / "no-such-bag"), "mcap")
     assert params["bridge_node"]["wait_for"][-1] == "recorder_node"
     assert "device_node" not in params
+
+
+def test_params_files_lay_over_the_config_in_order_before_set(root: Path, tmp_path) -> None:
+    """``--params``: an excitation, then an identified model, then ``--set``; a relative
+    ``urdf_path`` is the config's neighbour, whatever the working directory."""
+    model = tmp_path / "model.yaml"
+    model.write_text(
+        "/**/observer_node:\n  ros__parameters:\n    gain: 3.0\n    urdf:\n"
+        "      coulomb_n_m: [0.1, 0.2, 0.3]\n"
+    )
+    config = root / "config" / "bridge_touch.yaml"
+    excite = root / "config" / "excite" / "touch.yaml"
+    params = resolved_params(config, {"observer_node": {"gain": 4.0}}, [excite, model])
+    assert params["/**"]["urdf_path"] == str(root / "config" / "urdf" / "phantom_omni.urdf")
+    assert params["environment_node"]["excitation.kind"] == "multisine"
+    assert params["environment_node"]["stiffness_n_per_m"] == 0.0  # the overlay's
+    assert params["controller_node"]["mode"] == "OL"
+    assert params["observer_node"]["urdf.coulomb_n_m"] == [0.1, 0.2, 0.3]
+    assert params["observer_node"]["gain"] == 4.0  # --set last
+    assert params["bridge_node"]["profile"] == "cartesian_wrench"  # the config's, kept
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("/**/no_such_node:\n  ros__parameters: {a: 1}\n")
+    with pytest.raises(InputError, match="no_such_node"):
+        resolved_params(config, {}, [bad])
+    with pytest.raises(InputError, match=r"missing\.yaml"):
+        resolved_params(config, {}, [tmp_path / "missing.yaml"])
 
 
 def test_a_teleoperation_side_with_a_bridge_in_its_devices_place(root: Path) -> None:
@@ -48,3 +74,13 @@ def test_the_robot_description_goes_to_every_urdf_model() -> None:
     assert params["/**"]["robot_description"] == "<robot/>"
     with pytest.raises(InputError, match="no node of the config has model: urdf"):
         fill({"/**": {"model": "slide"}}, "<robot/>")
+
+
+def test_an_installed_overlay_by_its_name_in_a_folder() -> None:
+    """``--params excite/touch`` finds the installed overlay as ``haptic-launch slide_sim``
+    finds a config (a path that exists first)."""
+    assert resolve_config("excite/touch") == config_dir() / "excite" / "touch.yaml"
+    assert resolve_config("excite/forcedimension.yaml").name == "forcedimension.yaml"
+    assert resolve_config("bridge_touch") == config_dir() / "bridge_touch.yaml"
+    with pytest.raises(InputError, match="no config 'excite/none'"):
+        resolve_config("excite/none")
