@@ -42,6 +42,11 @@ from haptic_msgs_py.topics import EE_POSE, EE_TWIST, PARAMETER_EVENTS, WRENCH_ME
 MOTION_TYPES = (POSE, JOINT_STATE)
 AXES = {"x": 0, "y": 1, "z": 2}
 BATCH = 16_384  # messages decoded at once per topic
+#: what an empty wrench_measured means: a device without a force sensor (a bridge's)
+NO_SENSOR = (
+    " (the device has no force sensor: --force-topic wrench_estimate analyses the observer's "
+    "estimate of a DOB session instead)"
+)
 
 
 @dataclass(frozen=True)
@@ -144,7 +149,8 @@ def read_bag(path: str | Path, selection: Selection | None = None) -> BagData:
                 gc.enable()
     for topic in (motion_topic, force_topic):
         if series[topic].stamps_ns.size == 0:
-            raise BagError(f"{shown}: topic {topic} has no messages")
+            why = NO_SENSOR if topic == force_topic and topic.endswith(WRENCH_MEASURED) else ""
+            raise BagError(f"{shown}: topic {topic} has no messages{why}")
     motion = series[motion_topic]
     velocity = None
     if mtype == POSE:
