@@ -27,6 +27,7 @@ from __future__ import annotations
 import os
 import re
 import subprocess
+import tempfile
 import threading
 import time
 from collections.abc import Mapping, Sequence
@@ -112,19 +113,28 @@ def cycle_cost(
     mode: str = "OL",
     sets: Sequence[str] = (),
     watched: Mapping[str, str] | None = None,
+    record: bool = False,
 ) -> CycleCost:
     """The CPU a cycle of the slide loop costs with ``groups`` sharing processes (nodes in no
     group alone; ``[]``: four processes), in ``mode``, with ``sets`` (``haptic-launch --set``),
-    and with this process watching the ``watched`` topics (topic -> type) as the calling test
-    will (a ``rosgraph.Collector``: its CPU counts); measured once per layout."""
-    key = (*(tuple(sorted(g)) for g in groups), (mode, *sets), tuple(sorted(watched or {})))
+    with this process watching the ``watched`` topics (topic -> type) as the calling test
+    will (a ``rosgraph.Collector``: its CPU counts), and with the session recorded
+    (``record``: ``--record``'s recorder, a process of its own); measured once per layout."""
+    key = (
+        *(tuple(sorted(g)) for g in groups),
+        (mode, *sets),
+        tuple(sorted(watched or {})),
+        ("record",) if record else (),
+    )
     if key not in _measured:
         argv = [str(BIN / "haptic-launch"), str(ROOT / "config" / "slide_sim.yaml")]
         argv += [a for g in groups for a in ("--group", ",".join(g))] or ["--processes"]
         argv += ["--set", f"device_node:duration_s={MEASURE_S}"]
         argv += ["--set", f"controller_node:mode={mode}", "--set", "controller_node:kf=1.0"]
         argv += [a for s in sets for a in ("--set", s)]
-        _measured[key] = _probe(argv, {"": watched} if watched else None)
+        with tempfile.TemporaryDirectory(prefix="capacity-") as tmp:
+            argv += ["--record", str(Path(tmp) / "bag")] if record else []
+            _measured[key] = _probe(argv, {"": watched} if watched else None)
     return _measured[key]
 
 
@@ -290,12 +300,15 @@ def require_realtime(
     mode: str = "OL",
     sets: Sequence[str] = (),
     watched: Mapping[str, str] | None = None,
+    record: bool = False,
 ) -> CycleCost:
     """Skip the calling test unless a cycle of this layout (``cycle_cost``, with the test
-    watching ``watched``) fits in what this machine's CPUs give a period, now, and its DDS
-    hops across processes fit in ``HOPS_SHARE`` of a period; returns the cost."""
-    cost = cycle_cost(groups, mode, sets, watched)
+    watching ``watched``, recorded when ``record``) fits in what this machine's CPUs give a
+    period, now, and its DDS hops across processes fit in ``HOPS_SHARE`` of a period; returns
+    the cost."""
+    cost = cycle_cost(groups, mode, sets, watched, record)
     layout = " | ".join(", ".join(g) for g in groups) or "four processes"
+    layout += ", recorded" if record else ""
     if not cost.fits():
         watching = f", this test watching {len(watched)} topics" if watched else ""
         pytest.skip(f"{layout}; {mode}{watching}: {cost.text()}")

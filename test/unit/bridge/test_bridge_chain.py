@@ -1,0 +1,142 @@
+"""The identification chain through the bridge's own code, in batch (issue 31).
+
+Each device's chain as a lab runs it, every command on time (``support.bridge_batch``: the test
+driver's plant and semantics, ``StateReader`` and ``BridgeLoop``, the loop's stages): the
+excitation session (the bridge config with ``config/excite/<device>.yaml`` laid over it, as
+``haptic-launch --params`` lays it) -> the loop's ``joint_states`` as ``--record`` writes them,
+into a bag -> ``haptic-identify`` on that bag -> a DOB session with the YAML it wrote, the hand
+pushing into the config's wall. The real-time graph test
+(``test/graph/realtime/test_bridge_chain.py``) runs the same chain through the processes; this
+one is deterministic and carries on where a loaded machine makes that one skip.
+
+- Force Dimension (``config/bridge_forcedimension.yaml``, the point-mass device of
+  ``config/point_mass_sim.yaml`` underneath): every axis's mass within 5 % and viscous friction
+  within 10 % of the plant's truth, the estimate within 5 % RMS of the true hand force's span
+  in contact.
+- Touch (``config/bridge_touch.yaml``, ``config/phantom_omni_sim.yaml``'s simulated Touch
+  underneath): the joint friction identification finds each joint's Coulomb friction and the
+  speed it turns over; the rest of issue 31's figures are not reached and the test says so
+  with the figures (docs/devices.md: the 12 g payload is inertia the friction fit cannot
+  identify, the viscous friction too small to resolve, the estimate limited by the encoder).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from haptic_dob.cli.identify import main as identify
+from haptic_dob.core.environment import VirtualWall
+from haptic_dob.runtime.configs import urdf_beside
+from haptic_dob.runtime.params import build, load_node_params, node_view
+from support.bridge_batch import BridgeRecord, run_bridge
+from support.drivers import plants
+from support.drivers.run import SLIDE_HAND
+from support.joint_bags import write_joint_states
+from support.paths import ROOT
+
+pytestmark = pytest.mark.slow
+
+CONFIG = ROOT / "config"
+EXCITE_S = 21.0  # the excitation overlays' duration_s
+DOB_S = 8.0  # the hand's 1 s ramp, 2 s settling, then 6 s in contact
+#: the Touch's hand: config/phantom_omni_sim.yaml's (a 1 N push onto the floor, a slow swing)
+TOUCH_HAND = {
+    k.removeprefix("hand."): v
+    for k, v in load_node_params(plants.TOUCH_SIM)["device_node"].items()
+    if k.startswith("hand.")
+}
+
+
+def session(*files: Path, over: dict[str, dict[str, Any]] | None = None) -> dict[str, Any]:
+    """The node sections of ``files`` laid over each other in order, then ``over``: what
+    ``haptic-launch FILE --params FILE...`` gives the nodes."""
+    out: dict[str, dict[str, Any]] = {}
+    for f in files:
+        nodes = load_node_params(f)
+        urdf_beside(nodes, f)
+        for node, values in nodes.items():
+            out.setdefault(node, {}).update(values)
+    for node, values in (over or {}).items():
+        out.setdefault(node, {}).update(values)
+    return out
+
+
+def identified(record: BridgeRecord, tmp: Path, args: list[str]) -> Path:
+    """``haptic-identify`` on the record's joint states as a bag: the model YAML it wrote."""
+    bag = write_joint_states(
+        tmp / "bag", record.stamps_ns, record.joint_names, record.q, record.effort, "mcap"
+    )
+    model = tmp / "model.yaml"
+    assert identify([str(bag), *args, "--write-yaml", str(model)]) == 0
+    return model
+
+
+def contact_error(record: BridgeRecord, nodes: dict[str, Any]) -> tuple[float, float]:
+    """The estimate's RMS error over the true force's span in contact, and the share of samples
+    in contact after the settling."""
+    share, rms, span = record.in_contact(build(VirtualWall, node_view(nodes, "environment_node")))
+    return rms / span, share
+
+
+@pytest.fixture(scope="module")
+def fd(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], dict[str, Any], float]:
+    """The Force Dimension chain: the identified model, the plant's truth and the figure."""
+    tmp = tmp_path_factory.mktemp("fd")
+    config = CONFIG / "bridge_forcedimension.yaml"
+    excite = session(config, CONFIG / "excite" / "forcedimension.yaml")
+    plant = plants.point_mass(1000.0, 0, {"behaviour": "none"}, (0.0, 0.0, -1.0))
+    record = run_bridge(excite, plant, EXCITE_S)
+    model = identified(record, tmp, ["--axes", "fd_x,fd_y,fd_z"])
+    dob = session(config, model, over={"controller_node": {"mode": "DOB"}})
+    pusher = plants.point_mass(1000.0, 0, SLIDE_HAND, (1.0, 0.0, 0.0))
+    error, share = contact_error(run_bridge(dob, pusher, DOB_S), dob)
+    assert share > 0.9
+    return load_node_params(model)["observer_node"], plant.truth()["cartesian"], error
+
+
+def test_forcedimension_identification_finds_the_plant(fd) -> None:
+    """Mass within 5 %, viscous friction within 10 % of the plant's truth on every axis
+    (measured: +0.9-1.0 % and -0.8 to -1.4 %)."""
+    model, truth, _ = fd
+    for i in range(3):
+        assert model["point_mass.mass_kg"][i] == pytest.approx(truth["mass_kg"][i], rel=0.05)
+        got = model["point_mass.viscous_n_s_per_m"][i]
+        assert got == pytest.approx(truth["viscous_n_s_per_m"][i], rel=0.10)
+
+
+def test_forcedimension_dob_estimates_the_hand_within_5_percent(fd) -> None:
+    """The estimate's RMS error in contact within 5 % of the true force's span (measured 4.5 %;
+    4.6 % with the plant's truth as the model: the observer's lag, the encoder and stiction)."""
+    assert fd[2] <= 0.05, fd[2]
+
+
+def test_touch_chain_what_the_friction_fit_finds(tmp_path: Path) -> None:
+    """The Touch through the bridge: the joint friction identification (``--urdf``) finds each
+    joint's Coulomb friction within 30 % and the speed it turns over within a factor of 2
+    (measured on this excitation: Coulomb 1-36 %, the shoulder's and elbow's viscous friction
+    off by up to 9x: the payload's weight and inertia, which the URDF lacks, land in their
+    residual); the DOB estimate in contact is then within 15 % (measured 12.5 %). Issue 31's
+    5 % is not reached (docs/devices.md has why): the test says so with the figure."""
+    config = CONFIG / "bridge_touch.yaml"
+    excite = session(config, CONFIG / "excite" / "touch.yaml")
+    plant = plants.touch(500.0, 0, {"behaviour": "none"}, (0.0, 0.0, -1.0))
+    truth = plant.truth()
+    record = run_bridge(excite, plant, EXCITE_S)
+    assert np.abs(record.effort).max(axis=0).tolist() < truth["effort_limits_n_m"]  # no saturation
+    urdf = excite["/**"]["urdf_path"]
+    model_file = identified(record, tmp_path, ["--urdf", urdf, "--tip-frame", "tip"])
+    model = load_node_params(model_file)["observer_node"]
+    coulomb = np.array(model["urdf.coulomb_n_m"])
+    np.testing.assert_allclose(coulomb, truth["coulomb_n_m"], rtol=0.30)
+    speeds = np.array(model["urdf.coulomb_speed_rad_per_s"]) / truth["coulomb_speed_rad_per_s"]
+    assert np.all((speeds > 0.5) & (speeds < 2.0)), speeds
+    dob = session(config, model_file, over={"controller_node": {"mode": "DOB"}})
+    pusher = plants.touch(500.0, 0, TOUCH_HAND, (0.0, 0.0, -1.0))
+    error, share = contact_error(run_bridge(dob, pusher, DOB_S), dob)
+    assert share > 0.9 and error <= 0.15, (share, error)
+    if error > 0.05:
+        pytest.xfail(f"issue 31's 5 %: the Touch's estimate is within {100 * error:.1f} %")
