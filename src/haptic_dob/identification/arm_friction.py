@@ -108,11 +108,14 @@ def identify_arm_friction(
     r, v = _unexplained(rigid, f, position, effort)
     r_w, v_w = (r, v) if wide is f else _unexplained(rigid, wide, position, effort)
     split = int((1.0 - holdout) * n)
+    whole, whole_w = f.contiguous(stamps_ns), wide.contiguous(stamps_ns)  # no gap in reach
     every = np.arange(2 * f.window, split, f.step)  # slow samples too: the turn shows there
+    every = every[whole[every]]
     every_w = np.arange(2 * wide.window, split, wide.step)
+    every_w = every_w[whole_w[every_w]]
     out = []
     for j, name in enumerate(names):
-        usable = f.usable(v_light[:, j], min_speed)
+        usable = f.usable(v_light[:, j], min_speed) & whole
         moving = np.flatnonzero(usable[:split])
         test_idx = np.flatnonzero(usable[split:])[:: f.step] + split
         if len(moving) < 20 * f.step or len(test_idx) < 10:

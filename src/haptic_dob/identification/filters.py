@@ -5,8 +5,9 @@ Positions are low-passed by a zero-phase Butterworth filter and differentiated b
 the effort of sample k, applied over [k-1, k), is centred on the sample like the central
 derivatives and filtered the same way; the Coulomb term is the filtered sign of a lightly
 smoothed velocity. The same linear filters on every term make their lag and gain cancel. Samples
-at rest are left out (stiction is in no model), as are the filters' transients at both ends, and
-the rest is decimated to about independent residuals so that standard errors mean something.
+at rest are left out (stiction is in no model), as are the filters' transients at both ends and
+around a gap in the stamps (``contiguous``: states lost), and the rest is decimated to about
+independent residuals so that standard errors mean something.
 Arrays are along axis 0 (one column per joint for an arm).
 """
 
@@ -80,6 +81,18 @@ class MotionFilters:
         keep[:edge] = False
         keep[len(keep) - edge :] = False
         return np.asarray(keep)
+
+    def contiguous(self, stamps_ns: NDArray[np.int64]) -> NDArray[np.bool_]:
+        """Samples whose filters' support holds no gap in the stamps (a step of more than 1.5
+        periods: states a driver or the network lost). The filters take the samples as one
+        period apart, which is wrong across a gap: a fit leaves those samples out."""
+        ok = np.ones(len(stamps_ns), dtype=bool)
+        reach = 2 * self.window  # the Savitzky-Golay windows of the low-passed terms
+        for g in np.flatnonzero(np.diff(stamps_ns) > 1.5e9 * self.dt):
+            ok[max(0, g - reach) : g + 2 + reach] = False
+        if ok.all():
+            return ok
+        return np.asarray(signal.sosfiltfilt(self.sos, ok.astype(float)) > 0.99)  # its tail
 
     @property
     def step(self) -> int:

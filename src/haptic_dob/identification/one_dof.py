@@ -103,7 +103,7 @@ def least_squares(rec: JointRecord, cutoff_hz: float = 40.0, min_speed: float = 
     _, v, a = f.motion(rec.position)
     u = f.effort(rec.effort)
     v_light = f.light_velocity(rec.position)
-    idx = np.flatnonzero(f.usable(v_light, min_speed))[:: f.step]
+    idx = np.flatnonzero(f.usable(v_light, min_speed) & f.contiguous(rec.stamps_ns))[:: f.step]
     if len(idx) < 20:
         raise IdentificationError(
             f"{rec.joint}: too little motion to fit ({len(idx)} usable samples moving faster "

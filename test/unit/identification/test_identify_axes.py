@@ -145,3 +145,20 @@ def test_held_by_a_hand_the_fit_is_not_the_devices(session: BatchRecord) -> None
     assert fit.axes[0].viscous_n_s_per_m > 5.0 * t.viscous_n_s_per_m[0]
     held_rms = fit.axes[0].rms_residual_n or 0.0
     assert held_rms > 10.0 * (free.axes[0].rms_residual_n or 1.0)
+
+
+def test_states_lost_on_the_way_are_left_out_not_bridged(session: BatchRecord) -> None:
+    """A record with gaps (states a loaded machine or a best-effort driver lost: 150 gaps of 1 to
+    60 samples) fits as the whole one does: the samples whose filters reach over a gap are left
+    out (measured: masses +0.6 to +0.9 %, viscous -0.7 to -1.7 %; taken as one period apart, the
+    filters made the masses 82-88 % low)."""
+    rng = np.random.default_rng(1)
+    keep = np.ones(len(session.stamps_ns), dtype=bool)
+    for start in rng.choice(np.arange(2000, len(keep) - 100), 150, replace=False):
+        keep[start : start + rng.integers(1, 61)] = False
+    s = session
+    fit = identify_axes(s.stamps_ns[keep], s.q[keep], s.effort[keep], s.joint_names)
+    t = truth()
+    for i, f in enumerate(fit.axes):
+        assert f.mass_kg == pytest.approx(t.mass_kg[i], rel=0.05), f
+        assert f.viscous_n_s_per_m == pytest.approx(t.viscous_n_s_per_m[i], rel=0.10), f
