@@ -7,7 +7,9 @@ per command: arrival, the state answered, values) into the config's ``out`` dire
 
 Config keys: ``kind`` (``fd``, ``touch``, ``arm``), ``rate_hz``, ``seed``, ``out``, ``hand``
 (``HandParams`` fields), ``hand_direction`` (fd, touch: the push's unit vector in the base
-frame), ``button`` (touch: the white button held from the start), ``table_z`` (arm). Test
+frame), ``button`` (touch: the white button held from the start), ``inkwell`` (touch: the
+stylus rests in its inkwell, the plant held at its start, until the first force the driver
+applies: an arm nobody holds falls under its weight while the loop starts), ``table_z`` (arm). Test
 controls in the driver's namespace: ``test/pause`` (``std_msgs/Float64``: publish no state for
 that many seconds, the plant and the commands going on) and ``test/button``
 (``std_msgs/Bool``, touch: the white button).
@@ -87,6 +89,7 @@ class DriverNode(LoopNode):
             )
         raw_subscription(self, "std_msgs/msg/Float64", f"{ns}/test/pause", self._on_pause, LATCHED)
         self._button = bool(cfg.get("button", False))
+        self._resting = self.kind == "touch" and bool(cfg.get("inkwell", False))
         self._written = tuple(0.0 for _ in range(self.plant.dof))  # effort in force (plant joints)
         self._force = np.zeros(3)  # touch: the Cartesian force in force (base frame)
         self.deadline = time.monotonic() + 0.2
@@ -132,7 +135,10 @@ class DriverNode(LoopNode):
         if self._k >= 0:
             if self._answered != self._stamp and self.on_time:
                 self.late += 1
-            self.plant.apply(self._effort())
+            effort = self._effort()
+            self._resting = self._resting and not any(self._force)
+            if not self._resting:
+                self.plant.apply(effort)
         self._k += 1
         s = self.plant.sample()
         if self._k == 0:

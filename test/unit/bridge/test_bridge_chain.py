@@ -138,5 +138,8 @@ def test_touch_chain_what_the_friction_fit_finds(tmp_path: Path) -> None:
     pusher = plants.touch(500.0, 0, TOUCH_HAND, (0.0, 0.0, -1.0))
     error, share = contact_error(run_bridge(dob, pusher, DOB_S), dob)
     assert share > 0.9 and error <= 0.15, (share, error)
-    if error > 0.05:
-        pytest.xfail(f"issue 31's 5 %: the Touch's estimate is within {100 * error:.1f} %")
+    pytest.xfail(
+        f"issue 31's figures: no mass (the payload is inertia the friction fit cannot give), "
+        f"viscous friction {np.round(model['urdf.viscous_n_m_s_per_rad'], 5).tolist()} against "
+        f"{truth['viscous_n_m_s_per_rad']} N m s/rad, the estimate within {100 * error:.1f} %"
+    )

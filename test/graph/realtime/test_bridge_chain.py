@@ -1,0 +1,210 @@
+"""The identification chain through the bridge, in real time, for each test driver (issue 31).
+
+What docs/devices.md tells a lab to type, against a test driver whose plant's truth the test
+knows: the excitation session (``haptic-launch <config> --params excite/<device> --record``:
+a multisine along each axis within the clamp, nobody holding the stylus, the bridge composed
+with the loop) -> ``haptic-identify`` on that bag (``--axes`` for the Force Dimension, the joint
+friction ``--urdf ... --tip-frame tip`` for the Touch) writing the model's YAML -> a DOB session
+with it (``--params MODEL --set controller_node:mode=DOB``), recorded, the simulated hand pushing
+into the config's wall. The estimate the bag holds is matched by stamp with the hand force the
+driver's plant knows; the figure is the RMS of the 3-D error over the true force's span along the
+wall's normal, in contact after the hand's 2 s ramp (as ``test_point_mass_chain.py``).
+
+- forcedimension_ros2-like (1 kHz, config/point_mass_sim.yaml's device underneath): the
+  mass within 5 % and the viscous friction within 10 % of the plant on every axis, the estimate
+  within 5 %.
+- Touch-like (500 Hz, best-effort position-only states, the white button gating the force;
+  config/phantom_omni_sim.yaml's Touch underneath): the Coulomb friction and its turn speed are
+  found; the estimate within 20 % (a regression bound); issue 31's figures are not reached
+  (docs/devices.md says why) and the test says so with its figures (xfail).
+
+Each skips where the suite's capacity measurement says this machine cannot carry the composed
+loop and its recorder in real time now, or where the Python test driver itself did not hold its
+rate (a real driver does).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from haptic_dob.bag.bagfile import open_bag
+from haptic_dob.bag.cdr import decode_vectors
+from haptic_dob.core.environment import VirtualWall
+from haptic_dob.runtime.params import build, load_node_params, node_view
+from support.capacity import hop_floor_us, require_hop_floor, require_realtime
+from support.drivers import plants
+from support.drivers.run import SLIDE_HAND, Controls, Truth, start
+from support.paths import ROOT, tool
+from support.rosgraph import isolated_env, launch
+from support.waits import wait_until
+
+pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
+
+CONFIG = ROOT / "config"
+SLIDE_LOOP = ["device_node", "environment_node", "observer_node", "controller_node"]
+DRIVER_SHARE = 0.95  # the test driver's ticks over its periods, at least
+ON_TIME = 0.99  # commands before the driver's next state (issue 31: beside a CPU hog)
+DOB_S = 8.0  # the hand's 1 s ramp, 2 s settling, 5 s in contact
+SETTLE_S = 2.0
+WRENCH = "geometry_msgs/msg/WrenchStamped"
+TOUCH_HAND = {
+    k.removeprefix("hand."): v
+    for k, v in load_node_params(plants.TOUCH_SIM)["device_node"].items()
+    if k.startswith("hand.")
+}
+
+
+def premise(rate_hz: float) -> list[float]:
+    """Skip unless the composed loop with its recorder and the bridge's two hops fit real time
+    at ``rate_hz`` (DOB: the observer on the command's path); the hop measured now."""
+    require_realtime([SLIDE_LOOP], "DOB", record=True)
+    hops = [hop_floor_us()]
+    require_hop_floor(2, hops[0], rate_hz)
+    return hops
+
+
+def session(
+    tmp: Path, name: str, driver: dict[str, Any], config: str, args: list[str]
+) -> tuple[Truth, dict[str, Any], Path]:
+    """The driver and ``haptic-launch config --namespace /haptic ARGS --record`` until the
+    bridge's ``duration_s``; the driver's truth, the bridge's counts and the bag. A Touch's
+    white button is pressed once the bridge is up, as the user does."""
+    env = isolated_env()
+    stats, bag = tmp / f"{name}.json", tmp / f"{name}_bag"
+    drv = start(driver, env, tmp / f"{name}_driver")
+    controls = Controls(env, "/touch") if driver["kind"] == "touch" else None
+    argv = ["--namespace", "/haptic", *args, "--record", str(bag)]
+    # a Python test driver beside a CPU hog stalls for more than 10 ms now and then (BridgeRun)
+    sets = [f"bridge_node:stats_file={stats}", "bridge_node:state.timeout_s=0.05"]
+    graph = launch(str(CONFIG / config), env, sets, tmp / f"{name}.log", argv)
+    try:
+        if controls is not None:
+            assert wait_until(lambda: "the loop is up" in graph.output(), 120.0), graph.output()
+            controls.press(True)
+        assert graph.wait(180) == 0, graph.output()
+    finally:
+        graph.stop()
+        if controls is not None:
+            controls.close()
+        drv.stop()
+    return Truth.read(tmp / f"{name}_driver"), json.loads(stats.read_text()), bag
+
+
+def held_real_time(truth: Truth, counts: dict[str, Any], rate_hz: float) -> None:
+    """Skip unless the session kept its real-time premise: the test driver held its rate (a
+    real driver does) and ``ON_TIME`` of the commands reached it before its next state (a late
+    one acts a period later than the effort the bridge reports, which the figures presume);
+    no command refused."""
+    share = truth.ticked_share()
+    if share < DRIVER_SHARE:
+        pytest.skip(
+            f"the test driver ticked {100 * share:.0f} % of its periods at {rate_hz:g} Hz on "
+            f"this machine now (needs {100 * DRIVER_SHARE:.0f} %)"
+        )
+    assert counts["refused_commands"] == 0, counts
+    c = truth.counts
+    on_time = c["commands_on_time"] / max(1, c["commands_on_time"] + c["commands_late"])
+    if on_time < ON_TIME:
+        pytest.skip(
+            f"{100 * on_time:.1f} % of the commands reached the test driver before its next "
+            f"state at {rate_hz:g} Hz on this machine now (the chain presumes "
+            f"{100 * ON_TIME:g} %)"
+        )
+
+
+def identify(bag: Path, tmp: Path, args: list[str]) -> tuple[Path, dict[str, Any]]:
+    """``haptic-identify BAG ARGS --json --write-yaml``: the model file and the fit."""
+    model = tmp / "model.yaml"
+    argv = [tool("haptic-identify"), str(bag), *args, "--json", "--write-yaml", str(model)]
+    cli = subprocess.run(argv, capture_output=True, text=True, timeout=300)
+    assert cli.returncode == 0, cli.stderr
+    return model, json.loads(cli.stdout)
+
+
+def estimate_error(truth: Truth, bag: Path, config: str) -> float:
+    """The estimate's RMS 3-D error over the true hand force's span along the wall's normal, in
+    contact (the plant's tip inside the config's wall) after ``SETTLE_S``, matched by stamp."""
+    with open_bag(bag) as reader:
+        conns = [c for c in reader.connections if c.topic == "/haptic/wrench_estimate"]
+        datas = [data for _, _, data in reader.messages(connections=conns)]
+    stamps, est = decode_vectors(datas, WRENCH, (0, 1, 2))
+    idx = np.searchsorted(truth.stamps, stamps)
+    found = (idx < len(truth.stamps)) & (
+        truth.stamps[np.minimum(idx, len(truth.stamps) - 1)] == stamps
+    )
+    idx, est = idx[found], est[found]
+    assert len(idx) >= 0.9 * DOB_S * float(truth.info["rate_hz"]) * 0.5
+    wall = build(VirtualWall, node_view(load_node_params(CONFIG / config), "environment_node"))
+    normal = np.asarray(wall.normal)
+    t = (truth.stamps[idx] - truth.stamps[idx[0]]) * 1e-9
+    contact = ((truth.tip[idx] - np.asarray(wall.position)) @ normal > 0.0) & (t >= SETTLE_S)
+    assert contact.sum() >= 0.8 * (t >= SETTLE_S).sum(), "the hand did not hold the wall"
+    hand = truth.hand[idx][contact]
+    err = np.linalg.norm(est[contact] - hand, axis=1)
+    return float(np.sqrt(np.mean(err**2)) / np.ptp(hand @ normal))
+
+
+def test_forcedimension_chain_through_the_bridge(tmp_path: Path) -> None:
+    """Excite, record, identify every axis, then DOB with that model, the hand pushing +x into
+    the 800 N/m wall: issue 31's figures against the driver's hidden point mass."""
+    hops = premise(1000.0)
+    config = "bridge_forcedimension.yaml"
+    excite = ["--params", str(CONFIG / "excite" / "forcedimension.yaml")]
+    driver: dict[str, Any] = {"kind": "fd", "rate_hz": 1000.0}
+    truth, counts, bag = session(tmp_path, "excite", driver, config, excite)
+    held_real_time(truth, counts, 1000.0)
+    model, fit = identify(bag, tmp_path, ["--axes", "fd_x,fd_y,fd_z"])
+    plant = truth.info["plant"]["cartesian"]
+    for i, axis in enumerate(fit["axes"]):
+        assert axis["mass_kg"] == pytest.approx(plant["mass_kg"][i], rel=0.05), axis
+        assert axis["viscous_n_s_per_m"] == pytest.approx(
+            plant["viscous_n_s_per_m"][i], rel=0.10
+        ), axis
+    driver.update(hand=SLIDE_HAND, hand_direction=[1, 0, 0])
+    dob = ["--params", str(model), "--set", "controller_node:mode=DOB"]
+    dob += ["--set", f"bridge_node:duration_s={DOB_S}"]
+    truth, counts, bag = session(tmp_path, "dob", driver, config, dob)
+    hops.append(hop_floor_us())
+    require_hop_floor(2, max(hops))
+    held_real_time(truth, counts, 1000.0)
+    error = estimate_error(truth, bag, config)
+    assert error <= 0.05, error
+
+
+def test_touch_chain_through_the_bridge(tmp_path: Path) -> None:
+    """Excite, record, identify the joint friction beyond the URDF, then DOB with it, the hand
+    pushing the stylus down onto the 400 N/m floor: what the chain finds, and issue 31's 5 %
+    not reached (docs/devices.md: the payload is inertia, the encoder's counts at 500 Hz)."""
+    hops = premise(500.0)
+    config = "bridge_touch.yaml"
+    excite = ["--params", str(CONFIG / "excite" / "touch.yaml")]
+    driver: dict[str, Any] = {"kind": "touch", "rate_hz": 500.0, "hand_direction": [0, 0, -1]}
+    truth, counts, bag = session(tmp_path, "excite", {**driver, "inkwell": True}, config, excite)
+    held_real_time(truth, counts, 500.0)
+    urdf = str(CONFIG / "urdf" / "phantom_omni.urdf")
+    model, fit = identify(bag, tmp_path, ["--urdf", urdf, "--tip-frame", "tip"])
+    plant = truth.info["plant"]
+    coulomb = [j["coulomb"] for j in fit["joints"]]
+    np.testing.assert_allclose(coulomb, plant["coulomb_n_m"], rtol=0.30)
+    turn = np.array([j["coulomb_speed"] for j in fit["joints"]])
+    ratio = turn / np.array(plant["coulomb_speed_rad_per_s"])
+    assert np.all((ratio > 0.5) & (ratio < 2.0)), ratio
+    dob = ["--params", str(model), "--set", "controller_node:mode=DOB"]
+    dob += ["--set", f"bridge_node:duration_s={DOB_S}"]
+    truth, counts, bag = session(tmp_path, "dob", {**driver, "hand": TOUCH_HAND}, config, dob)
+    hops.append(hop_floor_us())
+    require_hop_floor(2, max(hops), 500.0)
+    held_real_time(truth, counts, 500.0)
+    error = estimate_error(truth, bag, config)
+    assert error <= 0.20, error  # a regression bound: measured 12.5 % in batch, 14.5 % here
+    pytest.xfail(
+        f"issue 31's figures: no mass (the payload is inertia the friction fit cannot give), "
+        f"viscous friction {[round(j['viscous'], 5) for j in fit['joints']]} against "
+        f"{plant['viscous_n_m_s_per_rad']} N m s/rad, the estimate within {100 * error:.1f} %"
+    )
