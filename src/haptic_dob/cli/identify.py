@@ -28,6 +28,7 @@ from haptic_dob.identification.arm_friction import ArmFrictionFit
 from haptic_dob.identification.filters import plus_minus
 from haptic_dob.identification.one_dof import METHODS, IdentificationError, SlideFit
 from haptic_dob.identification.per_axis import AxesFit
+from haptic_dob.runtime.configs import config_dir
 
 
 @dataclass(frozen=True)
@@ -97,13 +98,23 @@ def arm_table(fit: ArmFrictionFit, bag: str) -> str:
     return "\n".join(rows)
 
 
+def installed_urdf(name: str) -> str:
+    """``--urdf``: a file, or one the suite installs beside its configs (``urdf/
+    phantom_omni.urdf``) when no such file is here."""
+    if Path(name).is_file() or Path(name).is_absolute():
+        return name
+    beside = config_dir() / name
+    return str(beside) if beside.is_file() else name
+
+
 def arm_command(bag: str, topic: str, arm: ArmSpec, as_json: bool, write_yaml: str | None) -> int:
     """Identify an arm's joint friction, print it, optionally write it as the model's."""
     from haptic_dob.bag.joints import read_joints
     from haptic_dob.core.models import UrdfModel
     from haptic_dob.identification.arm_friction import identify_arm_friction
 
-    rigid = UrdfModel(arm.urdf, arm.tip_frame, arm.joints or None, viscous=0.0, coulomb=0.0)
+    urdf = installed_urdf(arm.urdf)
+    rigid = UrdfModel(urdf, arm.tip_frame, arm.joints or None, viscous=0.0, coulomb=0.0)
     js = read_joints(bag, topic, rigid.joint_names)
     try:
         fit = identify_arm_friction(
@@ -225,7 +236,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--json", action="store_true", help="one JSON line instead of the table")
     p.add_argument("--write-yaml", metavar="FILE", help="write the model as a params file")
     p.add_argument(
-        "--urdf", metavar="FILE", help="an arm: identify its joint friction beyond this URDF"
+        "--urdf",
+        metavar="FILE",
+        help="an arm: identify its joint friction beyond this URDF (a path, or one the suite "
+        "installs: urdf/phantom_omni.urdf)",
     )
     p.add_argument("--tip-frame", help="with --urdf: the arm's end-effector frame")
     p.add_argument(
