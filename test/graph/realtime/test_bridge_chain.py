@@ -96,11 +96,11 @@ def session(
     return Truth.read(tmp / f"{name}_driver"), json.loads(stats.read_text()), bag
 
 
-def held_real_time(truth: Truth, counts: dict[str, Any], rate_hz: float) -> None:
-    """Skip unless the session kept its real-time premise: the test driver held its rate (a
-    real driver does) and ``ON_TIME`` of the commands reached it before its next state (a late
-    one acts a period later than the effort the bridge reports, which the figures presume);
-    no command refused."""
+def kept_real_time(truth: Truth, counts: dict[str, Any], rate_hz: float) -> str:
+    """Skip when the test driver did not hold its rate (its own premise: a real driver does);
+    else '' when ``ON_TIME`` of the commands reached it before its next state, or why not (a late
+    command acts a period later than the effort the bridge reports, which the figures presume:
+    the test measures on and skips at the end with its figures). No command refused."""
     share = truth.ticked_share()
     if share < DRIVER_SHARE:
         pytest.skip(
@@ -110,20 +110,45 @@ def held_real_time(truth: Truth, counts: dict[str, Any], rate_hz: float) -> None
     assert counts["refused_commands"] == 0, counts
     c = truth.counts
     on_time = c["commands_on_time"] / max(1, c["commands_on_time"] + c["commands_late"])
-    if on_time < ON_TIME:
-        pytest.skip(
-            f"{100 * on_time:.1f} % of the commands reached the test driver before its next "
-            f"state at {rate_hz:g} Hz on this machine now (the chain presumes "
-            f"{100 * ON_TIME:g} %)"
-        )
+    if on_time >= ON_TIME:
+        return ""
+    return (
+        f"{100 * on_time:.1f} % of the commands reached the test driver before its next state "
+        f"at {rate_hz:g} Hz on this machine now (the chain presumes {100 * ON_TIME:g} %)"
+    )
 
 
-def identify(bag: Path, tmp: Path, args: list[str]) -> tuple[Path, dict[str, Any]]:
+class Figures:
+    """What a chain measured, said by a skip when its real-time premise did not hold."""
+
+    def __init__(self) -> None:
+        self.missed: list[str] = []
+        self.said: list[str] = []
+
+    def premise(self, why: str) -> None:
+        if why:
+            self.missed.append(why)
+
+    def check(self, ok: bool, figure: str) -> None:
+        """Assert ``ok`` where the premise held; else keep ``figure`` for the skip."""
+        self.said.append(figure)
+        if not self.missed:
+            assert ok, figure
+
+    def end(self) -> None:
+        """Skip with the figures when the premise did not hold."""
+        if self.missed:
+            pytest.skip(f"{'; '.join(self.missed)}; measured anyway: {'; '.join(self.said)}")
+
+
+def identify(bag: Path, tmp: Path, args: list[str], figures: Figures) -> tuple[Path, Any]:
     """``haptic-identify BAG ARGS --json --write-yaml``: the model file and the fit."""
     model = tmp / "model.yaml"
     argv = [tool("haptic-identify"), str(bag), *args, "--json", "--write-yaml", str(model)]
     cli = subprocess.run(argv, capture_output=True, text=True, timeout=300)
-    assert cli.returncode == 0, cli.stderr
+    if cli.returncode != 0:
+        figures.check(False, cli.stderr.strip())
+        figures.end()
     return model, json.loads(cli.stdout)
 
 
@@ -154,27 +179,30 @@ def test_forcedimension_chain_through_the_bridge(tmp_path: Path) -> None:
     """Excite, record, identify every axis, then DOB with that model, the hand pushing +x into
     the 800 N/m wall: issue 31's figures against the driver's hidden point mass."""
     hops = premise(1000.0)
+    figures = Figures()
     config = "bridge_forcedimension.yaml"
     excite = ["--params", str(CONFIG / "excite" / "forcedimension.yaml")]
     driver: dict[str, Any] = {"kind": "fd", "rate_hz": 1000.0}
     truth, counts, bag = session(tmp_path, "excite", driver, config, excite)
-    held_real_time(truth, counts, 1000.0)
-    model, fit = identify(bag, tmp_path, ["--axes", "fd_x,fd_y,fd_z"])
+    figures.premise(kept_real_time(truth, counts, 1000.0))
+    model, fit = identify(bag, tmp_path, ["--axes", "fd_x,fd_y,fd_z"], figures)
     plant = truth.info["plant"]["cartesian"]
     for i, axis in enumerate(fit["axes"]):
-        assert axis["mass_kg"] == pytest.approx(plant["mass_kg"][i], rel=0.05), axis
-        assert axis["viscous_n_s_per_m"] == pytest.approx(
-            plant["viscous_n_s_per_m"][i], rel=0.10
-        ), axis
+        m = axis["mass_kg"] / plant["mass_kg"][i] - 1.0
+        c = axis["viscous_n_s_per_m"] / plant["viscous_n_s_per_m"][i] - 1.0
+        name = axis["joint"]
+        figures.check(abs(m) <= 0.05, f"{name} mass {100 * m:+.1f} %")
+        figures.check(abs(c) <= 0.10, f"{name} viscous {100 * c:+.1f} %")
     driver.update(hand=SLIDE_HAND, hand_direction=[1, 0, 0])
     dob = ["--params", str(model), "--set", "controller_node:mode=DOB"]
     dob += ["--set", f"bridge_node:duration_s={DOB_S}"]
     truth, counts, bag = session(tmp_path, "dob", driver, config, dob)
     hops.append(hop_floor_us())
     require_hop_floor(2, max(hops))
-    held_real_time(truth, counts, 1000.0)
+    figures.premise(kept_real_time(truth, counts, 1000.0))
     error = estimate_error(truth, bag, config)
-    assert error <= 0.05, error
+    figures.check(error <= 0.05, f"estimate {100 * error:.1f} % of the span")
+    figures.end()
 
 
 def test_touch_chain_through_the_bridge(tmp_path: Path) -> None:
@@ -182,29 +210,34 @@ def test_touch_chain_through_the_bridge(tmp_path: Path) -> None:
     pushing the stylus down onto the 400 N/m floor: what the chain finds, and issue 31's 5 %
     not reached (docs/devices.md: the payload is inertia, the encoder's counts at 500 Hz)."""
     hops = premise(500.0)
+    figures = Figures()
     config = "bridge_touch.yaml"
     excite = ["--params", str(CONFIG / "excite" / "touch.yaml")]
     driver: dict[str, Any] = {"kind": "touch", "rate_hz": 500.0, "hand_direction": [0, 0, -1]}
     truth, counts, bag = session(tmp_path, "excite", {**driver, "inkwell": True}, config, excite)
-    held_real_time(truth, counts, 500.0)
+    figures.premise(kept_real_time(truth, counts, 500.0))
     urdf = str(CONFIG / "urdf" / "phantom_omni.urdf")
-    model, fit = identify(bag, tmp_path, ["--urdf", urdf, "--tip-frame", "tip"])
+    model, fit = identify(bag, tmp_path, ["--urdf", urdf, "--tip-frame", "tip"], figures)
     plant = truth.info["plant"]
-    coulomb = [j["coulomb"] for j in fit["joints"]]
-    np.testing.assert_allclose(coulomb, plant["coulomb_n_m"], rtol=0.30)
+    coulomb = np.array([j["coulomb"] for j in fit["joints"]]) / plant["coulomb_n_m"] - 1.0
+    figures.check(bool(np.all(abs(coulomb) <= 0.30)), f"Coulomb {np.round(100 * coulomb)} %")
     turn = np.array([j["coulomb_speed"] for j in fit["joints"]])
     ratio = turn / np.array(plant["coulomb_speed_rad_per_s"])
-    assert np.all((ratio > 0.5) & (ratio < 2.0)), ratio
+    figures.check(bool(np.all((ratio > 0.5) & (ratio < 2.0))), f"turn speeds x{ratio.round(2)}")
+    viscous = [round(j["viscous"], 5) for j in fit["joints"]]
+    figures.said.append(f"viscous {viscous} against {plant['viscous_n_m_s_per_rad']}")
     dob = ["--params", str(model), "--set", "controller_node:mode=DOB"]
     dob += ["--set", f"bridge_node:duration_s={DOB_S}"]
     truth, counts, bag = session(tmp_path, "dob", {**driver, "hand": TOUCH_HAND}, config, dob)
     hops.append(hop_floor_us())
     require_hop_floor(2, max(hops), 500.0)
-    held_real_time(truth, counts, 500.0)
+    figures.premise(kept_real_time(truth, counts, 500.0))
     error = estimate_error(truth, bag, config)
-    assert error <= 0.20, error  # a regression bound: measured 12.5 % in batch, 14.5 % here
+    # a regression bound, not issue 31's figure: measured 12.5 % in batch, 14.5 % in real time
+    figures.check(error <= 0.20, f"estimate {100 * error:.1f} % of the span")
+    figures.end()
     pytest.xfail(
         f"issue 31's figures: no mass (the payload is inertia the friction fit cannot give), "
-        f"viscous friction {[round(j['viscous'], 5) for j in fit['joints']]} against "
-        f"{plant['viscous_n_m_s_per_rad']} N m s/rad, the estimate within {100 * error:.1f} %"
+        f"viscous friction {viscous} against {plant['viscous_n_m_s_per_rad']} N m s/rad, the "
+        f"estimate within {100 * error:.1f} %"
     )
