@@ -39,10 +39,8 @@ from haptic_dob.core.environment import VirtualWall
 from haptic_dob.runtime.params import build, load_node_params, node_view
 from support.capacity import hop_floor_us, require_hop_floor, require_realtime
 from support.drivers import plants
-from support.drivers.run import SLIDE_HAND, Controls, Truth, start
+from support.drivers.run import SLIDE_HAND, Truth, bridge_session
 from support.paths import ROOT, tool
-from support.rosgraph import isolated_env, launch
-from support.waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -77,27 +75,13 @@ def session(
     tmp: Path, name: str, driver: dict[str, Any], config: str, args: list[str]
 ) -> tuple[Truth, dict[str, Any], Path]:
     """The driver and ``haptic-launch config --namespace /haptic ARGS --record`` until the
-    bridge's ``duration_s``; the driver's truth, the bridge's counts and the bag. A Touch's
-    white button is pressed once the bridge is up, as the user does."""
-    env = isolated_env()
-    stats, bag = tmp / f"{name}.json", tmp / f"{name}_bag"
-    drv = start(driver, env, tmp / f"{name}_driver")
-    controls = Controls(env, "/touch") if driver["kind"] == "touch" else None
-    argv = ["--namespace", "/haptic", *args, "--record", str(bag)]
+    bridge's ``duration_s``; the driver's truth, the bridge's counts and the bag."""
+    bag = tmp / f"{name}_bag"
     # a Python test driver beside a CPU hog stalls for more than 10 ms now and then (BridgeRun)
-    sets = [f"bridge_node:stats_file={stats}", "bridge_node:state.timeout_s=0.05"]
-    graph = launch(str(CONFIG / config), env, sets, tmp / f"{name}.log", argv)
-    try:
-        if controls is not None:
-            assert wait_until(lambda: "the loop is up" in graph.output(), 120.0), graph.output()
-            controls.press(True)
-        assert graph.wait(180) == 0, graph.output()
-    finally:
-        graph.stop()
-        if controls is not None:
-            controls.close()
-        drv.stop()
-    return Truth.read(tmp / f"{name}_driver"), json.loads(stats.read_text()), bag
+    sets = ["bridge_node:state.timeout_s=0.05"]
+    extra = [*args, "--record", str(bag)]
+    truth, counts = bridge_session(CONFIG / config, driver, tmp / name, sets, extra)
+    return truth, counts, bag
 
 
 def kept_real_time(truth: Truth, counts: dict[str, Any], rate_hz: float) -> str:

@@ -22,10 +22,9 @@ import pytest
 
 from haptic_dob.core.models.urdf import UrdfModel
 from support.capacity import hop_floor_us, require_hop_floor, require_realtime
-from support.drivers.run import SLIDE_HAND, Controls, Truth, start
+from support.drivers.run import SLIDE_HAND, Truth, bridge_session, start
 from support.paths import ROOT
 from support.rosgraph import Collector, isolated_env, launch
-from support.waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -45,33 +44,12 @@ def premise(rate_hz: float) -> list[float]:
 
 
 def run_session(
-    tmp_path: Path, driver: dict[str, object], config: str, sets: list[str], press: bool = False
+    tmp_path: Path, driver: dict[str, object], config: str, sets: list[str]
 ) -> tuple[Truth, dict[str, float]]:
     """The driver and ``haptic-launch config`` (namespace /haptic) for ``RUN_S`` of the
     bridge's run; the driver's truth and the bridge's counts."""
-    env = isolated_env()
-    stats = tmp_path / "bridge.json"
-    drv = start(driver, env, tmp_path / "driver")
-    controls = Controls(env, "/touch") if press else None
-    graph = launch(
-        str(ROOT / "config" / config),
-        env,
-        [f"bridge_node:duration_s={RUN_S}", f"bridge_node:stats_file={stats}", *sets],
-        tmp_path / "launch.log",
-        extra=["--namespace", "/haptic"],
-    )
-    try:
-        if controls is not None:  # the user holds the stylus's button once the bridge is up
-            up = "the loop is up"
-            assert wait_until(lambda: up in graph.output(), 120.0), graph.output()
-            controls.press(True)
-        assert graph.wait(120) == 0, graph.output()
-    finally:
-        graph.stop()
-        if controls is not None:
-            controls.close()
-        drv.stop()
-    return Truth.read(tmp_path / "driver"), json.loads(stats.read_text())
+    sets = [f"bridge_node:duration_s={RUN_S}", *sets]
+    return bridge_session(ROOT / "config" / config, dict(driver), tmp_path, sets, [])
 
 
 def closes(truth: Truth, counts: dict[str, float], rate_hz: float) -> None:
@@ -136,7 +114,7 @@ def test_touch_loop_closes_at_500hz_and_renders_the_wall(tmp_path) -> None:
     hops = premise(500.0)
     hand = {**SLIDE_HAND, "offset_m": 0.012}
     driver = {"kind": "touch", "rate_hz": 500.0, "hand": hand, "hand_direction": [0, 0, -1]}
-    truth, counts = run_session(tmp_path, driver, "bridge_touch.yaml", [], press=True)
+    truth, counts = run_session(tmp_path, driver, "bridge_touch.yaml", [])
     hops.append(hop_floor_us())
     require_hop_floor(2, max(hops), 500.0)
     closes(truth, counts, 500.0)

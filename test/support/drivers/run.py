@@ -1,7 +1,8 @@
 """Start a test driver from a test, work its controls, read its truth.
 
 ``start`` writes the driver's config and starts ``drivers/node.py`` as a process of its own
-(``rosgraph.Process``: its own session, stopped by SIGINT, killed if it lingers). ``Controls``
+(``rosgraph.Process``: its own session, stopped by SIGINT, killed if it lingers);
+``bridge_session`` runs one beside ``haptic-launch`` of a bridge config. ``Controls``
 holds one publisher per test control (transient local, so a message sent before the driver
 matched still arrives): the stylus button, a pause of the state. ``Truth`` reads what the driver
 wrote when it stopped.
@@ -12,13 +13,14 @@ from __future__ import annotations
 import json
 import os
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from support.rosgraph import Process
+from support.rosgraph import Process, isolated_env, launch
 from support.waits import wait_until
 
 NODE = Path(__file__).resolve().parent / "node.py"
@@ -51,6 +53,38 @@ def start(cfg: dict[str, Any], env: dict[str, str], directory: Path) -> Process:
         raise TimeoutError(f"the test driver did not start ticking:\n{proc.output()[-2000:]}")
     assert proc.proc.poll() is None, proc.output()[-2000:]
     return proc
+
+
+def bridge_session(
+    config: Path, driver: dict[str, Any], directory: Path, sets: Sequence[str], extra: Sequence[str]
+) -> tuple[Truth, dict[str, Any]]:
+    """The test driver of ``driver`` and ``haptic-launch config --namespace /haptic EXTRA --set
+    SETS`` on a fresh domain, until the bridge's ``duration_s``; a Touch's white button is
+    pressed once the bridge is up, as the user does. The driver's truth and the bridge's counts
+    (its ``stats_file``, ``directory/bridge.json``); the launch's output in ``launch.log``."""
+    env = isolated_env()
+    stats = directory / "bridge.json"
+    drv = start(driver, env, directory / "driver")
+    controls = Controls(env, "/touch") if driver["kind"] == "touch" else None
+    graph = launch(
+        str(config),
+        env,
+        [f"bridge_node:stats_file={stats}", *sets],
+        directory / "launch.log",
+        extra=["--namespace", "/haptic", *extra],
+    )
+    try:
+        if controls is not None:
+            up = "the loop is up"
+            assert wait_until(lambda: up in graph.output(), 120.0), graph.output()
+            controls.press(True)
+        assert graph.wait(180) == 0, graph.output()
+    finally:
+        graph.stop()
+        if controls is not None:
+            controls.close()
+        drv.stop()
+    return Truth.read(directory / "driver"), json.loads(stats.read_text())
 
 
 class Controls:
