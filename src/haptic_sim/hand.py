@@ -54,40 +54,71 @@ class HandParams:
 
     behaviour: str = field(
         default="semi_random",
-        metadata=param("what the simulated hand does", choices=BEHAVIOURS, read_only=True),
+        metadata=param(
+            description="what the simulated hand does", choices=BEHAVIOURS, read_only=True
+        ),
     )
     mass_kg: float = field(
-        default=0.1, metadata=param("hand mass moving with the handle", "kg", 0.0, 10.0)
+        default=0.1,
+        metadata=param(
+            description="hand mass moving with the handle", unit="kg", bounds=(0.0, 10.0)
+        ),
     )
     stiffness_n_per_m: float = field(
-        default=300.0, metadata=param("grip stiffness toward the reference", "N/m", 0.0, 1e5)
+        default=300.0,
+        metadata=param(
+            description="grip stiffness toward the reference", unit="N/m", bounds=(0.0, 1e5)
+        ),
     )
     damping_n_s_per_m: float = field(
-        default=10.0, metadata=param("grip damping toward the reference", "N s/m", 0.0, 1e3)
+        default=10.0,
+        metadata=param(
+            description="grip damping toward the reference", unit="N s/m", bounds=(0.0, 1e3)
+        ),
     )
     offset_m: float = field(
-        default=0.0091667, metadata=param("reference push past the start position", "m", -1.0, 1.0)
+        default=0.0091667,
+        metadata=param(
+            description="reference push past the start position", unit="m", bounds=(-1.0, 1.0)
+        ),
     )
     amplitude_m: float = field(
-        default=0.0011458, metadata=param("std of the semi-random reference motion", "m", 0.0, 1.0)
+        default=0.0011458,
+        metadata=param(
+            description="std of the semi-random reference motion", unit="m", bounds=(0.0, 1.0)
+        ),
     )
     band_low_hz: float = field(
-        default=0.05, metadata=param("low edge of the semi-random motion band", "Hz", 1e-3, 1e3)
+        default=0.05,
+        metadata=param(
+            description="low edge of the semi-random motion band", unit="Hz", bounds=(1e-3, 1e3)
+        ),
     )
     band_high_hz: float = field(
-        default=10.0, metadata=param("high edge of the semi-random motion band", "Hz", 1e-3, 1e3)
+        default=10.0,
+        metadata=param(
+            description="high edge of the semi-random motion band", unit="Hz", bounds=(1e-3, 1e3)
+        ),
     )
     ramp_s: float = field(
-        default=1.0, metadata=param("smooth ramp-in time of the reference", "s", 0.0, 1e3)
+        default=1.0,
+        metadata=param(
+            description="smooth ramp-in time of the reference", unit="s", bounds=(0.0, 1e3)
+        ),
     )
     perturbation_n: float = field(
-        default=0.0, metadata=param("push_hold: force pulse amplitude", "N", -100.0, 100.0)
+        default=0.0,
+        metadata=param(
+            description="push_hold: force pulse amplitude", unit="N", bounds=(-100.0, 100.0)
+        ),
     )
     perturbation_at_s: float = field(
-        default=1.5, metadata=param("push_hold: pulse start time", "s", 0.0, 1e6)
+        default=1.5,
+        metadata=param(description="push_hold: pulse start time", unit="s", bounds=(0.0, 1e6)),
     )
     perturbation_s: float = field(
-        default=0.005, metadata=param("push_hold: pulse duration", "s", 0.0, 10.0)
+        default=0.005,
+        metadata=param(description="push_hold: pulse duration", unit="s", bounds=(0.0, 10.0)),
     )
 
     def __post_init__(self) -> None:

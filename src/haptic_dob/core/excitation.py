@@ -46,58 +46,80 @@ class Excitation:
 
     kind: str = field(
         default="none",
-        metadata=param("force added: none, step, sine, chirp or multisine", choices=KINDS),
+        metadata=param(
+            description="force added: none, step, sine, chirp or multisine", choices=KINDS
+        ),
     )
     amplitude_n: float = field(
         default=0.0,
-        metadata=param("step size, or the peak of the other kinds per axis", "N", -100.0, 100.0),
+        metadata=param(
+            description="step size, or the peak of the other kinds per axis",
+            unit="N",
+            bounds=(-100.0, 100.0),
+        ),
     )
-    at_s: float = field(default=1.0, metadata=param("start (sample time)", "s", 0.0, 1e7))
+    at_s: float = field(
+        default=1.0, metadata=param(description="start (sample time)", unit="s", bounds=(0.0, 1e7))
+    )
     frequency_hz: float = field(
         default=2.0,
-        metadata=param("frequency of the sine (well below the loop rate)", "Hz", 0.0, 200.0),
+        metadata=param(
+            description="frequency of the sine (well below the loop rate)",
+            unit="Hz",
+            bounds=(0.0, 200.0),
+        ),
     )
     low_hz: float = field(
-        default=1.0, metadata=param("chirp and multisine: lowest frequency", "Hz", 1e-3, 200.0)
+        default=1.0,
+        metadata=param(
+            description="chirp and multisine: lowest frequency", unit="Hz", bounds=(1e-3, 200.0)
+        ),
     )
     high_hz: float = field(
         default=8.0,
         metadata=param(
-            "chirp and multisine: highest frequency (identification's filters bias the mass "
-            "upward above about 10 Hz)",
-            "Hz",
-            1e-3,
-            200.0,
+            description=(
+                "chirp and multisine: highest frequency (identification's filters bias the mass "
+                "upward above about 10 Hz)"
+            ),
+            unit="Hz",
+            bounds=(1e-3, 200.0),
         ),
     )
     period_s: float = field(
         default=10.0,
         metadata=param(
-            "chirp: one sweep (then it repeats); multisine: its period (frequency step 1/period)",
-            "s",
-            0.1,
-            1e4,
+            description=(
+                "chirp: one sweep (then it repeats); multisine: its period (frequency step "
+                "1/period)"
+            ),
+            unit="s",
+            bounds=(0.1, 1e4),
         ),
     )
     along: str = field(
         default="normal",
         metadata=param(
-            "normal: along the wall normal; axes: a signal of its own along each of x, y, z",
+            description=(
+                "normal: along the wall normal; axes: a signal of its own along each of x, y, z"
+            ),
             choices=ALONG,
         ),
     )
     hold_n_per_m: float = field(
         default=0.0,
         metadata=param(
-            "stiffness of an isotropic spring toward hold_at (0: none), keeping a device that "
-            "nothing else holds in its workspace",
-            "N/m",
-            0.0,
-            1e4,
+            description=(
+                "stiffness of an isotropic spring toward hold_at (0: none), keeping a device that "
+                "nothing else holds in its workspace"
+            ),
+            unit="N/m",
+            bounds=(0.0, 1e4),
         ),
     )
     hold_at: tuple[float, float, float] = field(
-        default=(0.0, 0.0, 0.0), metadata=param("where the holding spring pulls (x, y, z)", "m")
+        default=(0.0, 0.0, 0.0),
+        metadata=param(description="where the holding spring pulls (x, y, z)", unit="m"),
     )
     # the multisine's components: angular frequencies (rad/s), each axis's phases (rad, (3, n)),
     # the scale of a unit peak

@@ -40,39 +40,51 @@ class SlaveImpedance:
     bandwidth_hz: float = field(
         default=8.0,
         metadata=param(
-            "each joint's loop bandwidth on its own inertia at the start pose", "Hz", 0.1, 200.0
+            description="each joint's loop bandwidth on its own inertia at the start pose",
+            unit="Hz",
+            bounds=(0.1, 200.0),
         ),
     )
     damping_ratio: float = field(
-        default=1.0, metadata=param("each joint's damping ratio", "", 0.0, 10.0)
+        default=1.0, metadata=param(description="each joint's damping ratio", bounds=(0.0, 10.0))
     )
     stiffness_n_m_per_rad: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "joint stiffness K, one per joint; [] = from bandwidth_hz", "N m/rad", 0.0, 1e6
+            description="joint stiffness K, one per joint; [] = from bandwidth_hz",
+            unit="N m/rad",
+            bounds=(0.0, 1e6),
         ),
     )
     damping_n_m_s_per_rad: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "joint damping B, one per joint; [] = from damping_ratio", "N m s/rad", 0.0, 1e5
+            description="joint damping B, one per joint; [] = from damping_ratio",
+            unit="N m s/rad",
+            bounds=(0.0, 1e5),
         ),
     )
     ik_damping_m: float = field(
-        default=0.01, metadata=param("damping lambda of the IK's least squares", "m", 1e-6, 1.0)
+        default=0.01,
+        metadata=param(
+            description="damping lambda of the IK's least squares", unit="m", bounds=(1e-6, 1.0)
+        ),
     )
     posture_gain: float = field(
         default=0.01,
         metadata=param(
-            "per-period pull of the redundant joints toward the start posture", "", 0.0, 1.0
+            description="per-period pull of the redundant joints toward the start posture",
+            bounds=(0.0, 1.0),
         ),
     )
     max_joint_speed_rad_s: float = field(
         default=2.0,
-        metadata=param("largest speed of the joint target", "rad/s", 1e-3, 100.0),
+        metadata=param(
+            description="largest speed of the joint target", unit="rad/s", bounds=(1e-3, 100.0)
+        ),
     )
     gravity_compensation: bool = field(
-        default=True, metadata=param("add the model's gravity effort")
+        default=True, metadata=param(description="add the model's gravity effort")
     )
 
     def __post_init__(self) -> None:

@@ -221,16 +221,21 @@ class PhantomSettings:
     params: str = field(
         default="appendix_b",
         metadata=param(
-            "PHANToM 1.5 parameter set: thesis Table B.1 or Cavusoglu-Feygin-Tendick 2002",
+            description=(
+                "PHANToM 1.5 parameter set: thesis Table B.1 or Cavusoglu-Feygin-Tendick 2002"
+            ),
             choices=tuple(PHANTOM_PARAMS),
         ),
     )
     gravity: bool = field(
         default=True,
-        metadata=param("include gravity in the model (false: an observer that leaves G out)"),
+        metadata=param(
+            description="include gravity in the model (false: an observer that leaves G out)"
+        ),
     )
     viscous_n_m_s_per_rad: float = field(
-        default=0.0, metadata=param("viscous joint friction", "N m s/rad", 0.0, 10.0)
+        default=0.0,
+        metadata=param(description="viscous joint friction", unit="N m s/rad", bounds=(0.0, 10.0)),
     )
 
     def model(self) -> PhantomModel:

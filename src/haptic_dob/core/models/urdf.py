@@ -87,16 +87,21 @@ class UrdfSettings:
     """
 
     robot_description: str = field(
-        default="", metadata=param("URDF XML of the arm (model: urdf); wins over urdf_path")
+        default="",
+        metadata=param(description="URDF XML of the arm (model: urdf); wins over urdf_path"),
     )
-    urdf_path: str = field(default="", metadata=param("path of the arm's URDF file (model: urdf)"))
+    urdf_path: str = field(
+        default="", metadata=param(description="path of the arm's URDF file (model: urdf)")
+    )
     tip_frame: str = field(
-        default="", metadata=param("URDF frame whose origin is the end-effector point")
+        default="", metadata=param(description="URDF frame whose origin is the end-effector point")
     )
     # a list default: a tuple default would fix the array's length in the parameter table
     joint_names: list[str] | tuple[str, ...] = field(
         default_factory=lambda: [""],
-        metadata=param("joints used, in order; [''] = the chain from the root to tip_frame"),
+        metadata=param(
+            description="joints used, in order; [''] = the chain from the root to tip_frame"
+        ),
     )
 
     def model(self, options: UrdfOptions | None = None) -> UrdfModel:
@@ -133,47 +138,53 @@ class UrdfOptions:
 
     gravity: bool = field(
         default=True,
-        metadata=param("include gravity in the model (false: an observer that leaves G out)"),
+        metadata=param(
+            description="include gravity in the model (false: an observer that leaves G out)"
+        ),
     )
     # list defaults: a tuple default would fix the array's length in the parameter table
     viscous_n_m_s_per_rad: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "viscous joint friction (N s/m for a prismatic joint), one value for every joint or "
-            "one per joint; [] = each joint's <dynamics damping> from the URDF",
-            "N m s/rad",
-            0.0,
-            1e3,
+            description=(
+                "viscous joint friction (N s/m for a prismatic joint), one value for every joint "
+                "or one per joint; [] = each joint's <dynamics damping> from the URDF"
+            ),
+            unit="N m s/rad",
+            bounds=(0.0, 1e3),
         ),
     )
     coulomb_n_m: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "Coulomb joint friction (N for a prismatic joint), one value for every joint or one "
-            "per joint; [] = each joint's <dynamics friction> from the URDF",
-            "N m",
-            0.0,
-            1e3,
+            description=(
+                "Coulomb joint friction (N for a prismatic joint), one value for every joint or "
+                "one per joint; [] = each joint's <dynamics friction> from the URDF"
+            ),
+            unit="N m",
+            bounds=(0.0, 1e3),
         ),
     )
     coulomb_speed_rad_per_s: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "speed over which the Coulomb friction turns, Fc tanh(q'/v_c) (m/s for a prismatic "
-            "joint), one value for every joint or one per joint; [] or 0 = Fc sgn(q'). An "
-            "observer's model (haptic-identify --urdf fits it); a simulated arm smooths by its "
-            "own physics step and refuses it",
-            "rad/s",
-            0.0,
-            10.0,
+            description=(
+                "speed over which the Coulomb friction turns, Fc tanh(q'/v_c) (m/s for a prismatic "
+                "joint), one value for every joint or one per joint; [] or 0 = Fc sgn(q'). An "
+                "observer's model (haptic-identify --urdf fits it); a simulated arm smooths by its "
+                "own physics step and refuses it"
+            ),
+            unit="rad/s",
+            bounds=(0.0, 10.0),
         ),
     )
     payload_kg: float = field(
         default=0.0,
         metadata=param(
-            "a point mass at tip_frame's origin that the URDF does not have (a handle, a tool)",
-            "kg",
-            0.0,
-            100.0,
+            description=(
+                "a point mass at tip_frame's origin that the URDF does not have (a handle, a tool)"
+            ),
+            unit="kg",
+            bounds=(0.0, 100.0),
         ),
     )
