@@ -3,7 +3,8 @@
 ``SafetySettings`` (``safety.*``: the clamp, the rate limit, the command watchdog, the dead-man)
 and ``RunSettings`` (when the bridge starts and stops, what it writes) are frozen dataclasses
 read by ``build`` (``runtime.params``); ``bridge_specs`` is the whole table with the driver's
-groups (``driver_settings``). ``per_element`` spreads one value over every command element.
+``DriverProfile`` and groups (``driver_settings``). ``per_element`` spreads one value over every
+command element.
 """
 
 from __future__ import annotations
@@ -162,19 +163,28 @@ class RunSettings:
     )
 
 
+@dataclass(frozen=True)
+class DriverProfile:
+    """The driver's kind (``profile``): the defaults of its ``state.*`` and ``command.*``."""
+
+    profile: str = field(
+        default=PROFILES[0],
+        metadata=param(
+            description=(
+                "the driver's kind: ros2_control_effort (joint_state_broadcaster and an effort "
+                "forward_command_controller), cartesian_wrench (a Touch-like Cartesian force "
+                "input), suite (the suite's own contract)"
+            ),
+            choices=PROFILES,
+            read_only=True,
+        ),
+    )
+
+
 def bridge_specs() -> list[ParamSpec]:
     """The driver's, safety's and run's parameter rows (read-only: they define the session)."""
-    profile = ParamSpec(
-        "profile",
-        PROFILES[0],
-        "the driver's kind: ros2_control_effort (joint_state_broadcaster and an effort "
-        "forward_command_controller), cartesian_wrench (a Touch-like Cartesian force input), "
-        "suite (the suite's own contract)",
-        choices=PROFILES,
-        read_only=True,
-    )
     return [
-        profile,
+        *specs_of(DriverProfile),
         *specs_of(StateSettings, "state.", read_only=True),
         *specs_of(CommandSettings, "command.", read_only=True),
         *specs_of(FrameSettings, "frame.", read_only=True),

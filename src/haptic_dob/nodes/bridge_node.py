@@ -30,16 +30,16 @@ from haptic_dob.bridge.start import StartGate
 from haptic_dob.bridge.state import StateReader, check_cartesian
 from haptic_dob.core.models.factory import build_model, model_specs
 from haptic_dob.nodes.command_input import CommandInput
-from haptic_dob.nodes.common import (
-    command_authority_specs,
-    input_specs,
-    loop_specs,
-    main_for,
-    missing_nodes,
-    process_specs,
+from haptic_dob.nodes.common import main_for, missing_nodes
+from haptic_dob.nodes.settings import (
+    RELIABLE_INPUTS,
+    CommandInputSettings,
+    LoopInputs,
+    LoopTiming,
+    ProcessSettings,
 )
 from haptic_dob.runtime.discovery import exposure_warning
-from haptic_dob.runtime.params import ParamSpec, build
+from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
@@ -61,10 +61,10 @@ from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
 def bridge_node_specs() -> list[ParamSpec]:
     """Every parameter of the bridge node."""
     return [
-        *loop_specs(),
-        *input_specs("reliable"),
-        *command_authority_specs(),
-        *process_specs(),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs, defaults=RELIABLE_INPUTS),
+        *specs_of(CommandInputSettings),
+        *specs_of(ProcessSettings),
         *model_specs(),
         *bridge_specs(),
     ]

@@ -32,16 +32,17 @@ from typing import Any
 from rclpy.context import Context
 
 from haptic_dob.core.command_authority import new_token
-from haptic_dob.core.command_join import FALLBACKS, CommandJoin
+from haptic_dob.core.command_join import CommandJoin
 from haptic_dob.core.control import HandForce, ImpedanceController, ImpedanceLaw
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import (
-    command_token_spec,
-    input_specs,
-    loop_specs,
-    main_for,
-    process_specs,
+from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.settings import (
+    CommandOutputSettings,
+    ControllerSettings,
+    LoopInputs,
+    LoopTiming,
+    ProcessSettings,
 )
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
@@ -64,42 +65,13 @@ from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
 def controller_node_specs() -> list[ParamSpec]:
     """Every parameter of the controller node."""
     return [
-        *loop_specs(),
-        *input_specs("best_effort"),
-        command_token_spec(),
-        *process_specs(),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs),
+        *specs_of(CommandOutputSettings),
+        *specs_of(ProcessSettings),
         *model_specs(),
         *specs_of(ImpedanceLaw),
-        ParamSpec(
-            "input_warn_s",
-            2.0,
-            "warn when an input of a pending cycle is this late",
-            "s",
-            0.01,
-            3600.0,
-        ),
-        ParamSpec(
-            "warm_inputs",
-            True,
-            "subscribe to every mode's force input, so a switch to CL or DOB finds it flowing "
-            "(false: only the start mode's input; cheaper; a switch to another mode is refused)",
-            read_only=True,
-        ),
-        ParamSpec(
-            "fallback",
-            "zero",
-            "what to render when the mode's force input stops: zero force or OL",
-            choices=FALLBACKS,
-        ),
-        ParamSpec(
-            "input_timeout_s",
-            0.02,
-            "the mode's force input counts as stopped when its newest sample is this much sample "
-            "time older than the cycle",
-            "s",
-            0.001,
-            10.0,
-        ),
+        *specs_of(ControllerSettings),
     ]
 
 

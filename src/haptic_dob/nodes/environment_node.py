@@ -19,7 +19,8 @@ from rclpy.context import Context
 from haptic_dob.core.cycle import wall_force
 from haptic_dob.core.environment import VirtualWall
 from haptic_dob.core.excitation import Excitation
-from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
+from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.settings import LoopInputs, LoopTiming, ProcessSettings
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
@@ -35,9 +36,9 @@ from haptic_msgs_py.values import StampedVector
 def environment_node_specs() -> list[ParamSpec]:
     """Every parameter of the environment node (the wall and the excitation change at run time)."""
     return [
-        *loop_specs(),
-        *input_specs("best_effort"),
-        *process_specs(),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs),
+        *specs_of(ProcessSettings),
         *specs_of(VirtualWall),
         *specs_of(Excitation, "excitation."),
     ]

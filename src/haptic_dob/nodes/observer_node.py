@@ -22,7 +22,8 @@ from haptic_dob.core.models.base import DeviceModel
 from haptic_dob.core.models.factory import build_model, model_specs
 from haptic_dob.core.observers.disturbance import DisturbanceObserver
 from haptic_dob.core.observers.factory import ObserverSettings
-from haptic_dob.nodes.common import loop_specs, main_for, process_specs
+from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.settings import LoopTiming, ProcessSettings
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import ERROR, OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
@@ -37,7 +38,12 @@ from haptic_msgs_py.values import JointSample, StampedVector
 
 def observer_node_specs() -> list[ParamSpec]:
     """Every parameter of the observer node."""
-    return [*loop_specs(), *process_specs(), *model_specs(), *specs_of(ObserverSettings)]
+    return [
+        *specs_of(LoopTiming),
+        *specs_of(ProcessSettings),
+        *model_specs(),
+        *specs_of(ObserverSettings),
+    ]
 
 
 class ObserverNode(LoopNode):

@@ -20,12 +20,12 @@ from rclpy.context import Context
 from haptic_dob.core.command_authority import new_token
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import (
-    command_token_spec,
-    input_specs,
-    loop_specs,
-    main_for,
-    process_specs,
+from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.settings import (
+    CommandOutputSettings,
+    LoopInputs,
+    LoopTiming,
+    ProcessSettings,
 )
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
@@ -42,10 +42,10 @@ from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
 def slave_controller_node_specs() -> list[ParamSpec]:
     """Every parameter of the slave controller node."""
     return [
-        *loop_specs(),
-        *input_specs("best_effort"),
-        command_token_spec(),
-        *process_specs(),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs),
+        *specs_of(CommandOutputSettings),
+        *specs_of(ProcessSettings),
         *model_specs(),
         *specs_of(SlaveImpedance, "slave.", read_only=True),
     ]
