@@ -41,7 +41,6 @@ from haptic_dob.nodes.settings import (
 from haptic_dob.runtime.discovery import exposure_warning
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.driver_wire import (
@@ -79,8 +78,7 @@ class BridgeNode(LoopNode):
         name: str = "bridge_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, bridge_node_specs())
+        super().__init__(name, specs=bridge_node_specs(), context=context, namespace=namespace)
         v = self.params.values
         self.model = build_model(v)
         driver = DriverSettings.of(v)

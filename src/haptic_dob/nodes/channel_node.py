@@ -28,7 +28,6 @@ from haptic_dob.nodes.common import main_for
 from haptic_dob.nodes.settings import ChannelEnd, LoopInputs, LoopTiming, ProcessSettings
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_dob.teleop.ends import MasterEnd, PortMessage, SlaveEnd
 from haptic_dob.teleop.graph import TO_MASTER, TO_SLAVE
@@ -100,8 +99,7 @@ class ChannelNode(LoopNode):
         name: str = "channel_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, channel_node_specs())
+        super().__init__(name, specs=channel_node_specs(), context=context, namespace=namespace)
         v = self.params.values
         teleop = build(TeleopSettings, v, "teleop.")
         channel = build(ChannelSettings, v, "channel.")

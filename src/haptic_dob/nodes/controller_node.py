@@ -46,7 +46,6 @@ from haptic_dob.nodes.settings import (
 )
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
@@ -84,14 +83,13 @@ class ControllerNode(LoopNode):
         name: str = "controller_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, controller_node_specs(), self._settings, self._apply)
+        super().__init__(name, specs=controller_node_specs(), context=context, namespace=namespace)
         values = self.params.values
         self.model = build_model(values)
         self.period_ns = period_ns(values["rate_hz"])
         log = self.log
         self.join = CommandJoin(
-            ImpedanceController(self.model, self.params.settings),
+            ImpedanceController(self.model, build(ImpedanceLaw, values)),
             self.period_ns,
             needs_q=not self.model.constant_jacobian,
             input_timeout_ns=values["input_timeout_s"] * 1e9,
@@ -120,6 +118,7 @@ class ControllerNode(LoopNode):
         for topic, codec, callback in inputs:
             LoopSubscription(self, topic, codec, callback, profile)
         self.diagnostics = Diagnostics(self, self._report)
+        self.params.set_validator(self._settings, self._apply)
 
     @property
     def controller(self) -> ImpedanceController:
@@ -129,13 +128,12 @@ class ControllerNode(LoopNode):
     # --- parameters ------------------------------------------------------------------------
     def next_sample_ns(self) -> int | None:
         """The command after the newest sent is the first computed with a new law."""
-        join = getattr(self, "join", None)
-        return None if join is None or join.sent_ns < 0 else join.sent_ns + self.period_ns
+        sent = self.join.sent_ns
+        return None if sent < 0 else sent + self.period_ns
 
     def _settings(self, values: Mapping[str, Any]) -> ImpedanceLaw:
         law = build(ImpedanceLaw, values)
-        if hasattr(self, "join"):  # a change at run time, not the start-up values
-            self.join.check_switch(law)
+        self.join.check_switch(law)
         return law
 
     def _apply(self, law: ImpedanceLaw) -> None:

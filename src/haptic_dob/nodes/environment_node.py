@@ -23,7 +23,6 @@ from haptic_dob.nodes.common import main_for
 from haptic_dob.nodes.settings import LoopInputs, LoopTiming, ProcessSettings
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
@@ -60,9 +59,8 @@ class EnvironmentNode(LoopNode):
         name: str = "environment_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, environment_node_specs(), self._settings, self._apply)
-        self.wall, self.excitation = self.params.settings
+        super().__init__(name, specs=environment_node_specs(), context=context, namespace=namespace)
+        self.wall, self.excitation = self._settings(self.params.values)
         self._adds = self.excitation if self.excitation.active else None  # what wall_force adds
         self._pose: StampedVector | None = None
         self._twist: StampedVector | None = None
@@ -76,6 +74,7 @@ class EnvironmentNode(LoopNode):
         LoopSubscription(self, EE_POSE, codecs.POSE, self._on_pose, inputs)
         LoopSubscription(self, EE_TWIST, codecs.TWIST, self._on_twist, inputs)
         self.diagnostics = Diagnostics(self, self._report)
+        self.params.set_validator(self._settings, self._apply)
 
     def _report(self) -> Report:
         w = self.wall
@@ -93,7 +92,7 @@ class EnvironmentNode(LoopNode):
 
     def next_sample_ns(self) -> int | None:
         """The pose after the newest rendered is the first rendered with a changed wall."""
-        last = getattr(self, "_emitted_ns", -1)
+        last = self._emitted_ns
         return None if last < 0 else last + self._period_ns
 
     @staticmethod

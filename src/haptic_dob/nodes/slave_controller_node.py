@@ -29,7 +29,6 @@ from haptic_dob.nodes.settings import (
 )
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_dob.teleop.slave import SlaveController, SlaveImpedance
 from haptic_msgs_py import codecs
@@ -60,8 +59,9 @@ class SlaveControllerNode(LoopNode):
         name: str = "slave_controller_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, slave_controller_node_specs())
+        super().__init__(
+            name, specs=slave_controller_node_specs(), context=context, namespace=namespace
+        )
         v = self.params.values
         model = build_model(v)
         self.controller = SlaveController(

@@ -45,7 +45,6 @@ from rclpy.context import Context
 from haptic_dob.nodes.command_input import CommandInput
 from haptic_dob.nodes.common import main_for, missing_nodes
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
@@ -83,8 +82,7 @@ class DeviceNode(LoopNode):
         name: str = "device_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, device_node_specs())
+        super().__init__(name, specs=device_node_specs(), context=context, namespace=namespace)
         v = self.params.values
         self._start_with = start_topics(v["start_with"])
         self.device = build_device(v)
