@@ -42,29 +42,28 @@ class StateSettings:
         default="",
         metadata=param(
             description=(
-                "the driver's state topic (absolute, or relative to the bridge's namespace); not "
-                "the loop's own joint_states"
-            )
+                "the driver's state topic (absolute, or relative to the bridge's namespace)"
+            ),
+            details=("Not the loop's own joint_states."),
         ),
     )
     type: str = field(
         default="joint_states",
         metadata=param(
-            description=(
-                "sensor_msgs/JointState, or geometry_msgs/PoseStamped (a Cartesian model only: q "
-                "is the tip's position)"
-            ),
+            description=("sensor_msgs/JointState, or geometry_msgs/PoseStamped (Cartesian models)"),
             choices=STATE_TYPES,
+            details=("A pose state suits a Cartesian model only: q is the tip's position."),
         ),
     )
     reliability: str = field(
         default="reliable",
         metadata=param(
-            description=(
-                "QoS reliability of the subscription: reliable matches reliable publishers only "
-                "(joint_state_broadcaster), best_effort matches both (SensorDataQoS drivers)"
-            ),
+            description="QoS reliability of the subscription",
             choices=RELIABILITY,
+            details=(
+                "reliable matches reliable publishers only (joint_state_broadcaster), best_effort "
+                "matches both (SensorDataQoS drivers)."
+            ),
         ),
     )
     depth: int = field(
@@ -73,31 +72,29 @@ class StateSettings:
     stamp: str = field(
         default="driver",
         metadata=param(
-            description=(
-                "the stamp the loop's samples carry: the driver's header stamp, or the system "
-                "clock when the state arrives (receipt: for a driver whose stamps are zero or do "
-                "not advance)"
-            ),
+            description=("the stamp the loop's samples carry: the driver's, or the receipt time"),
             choices=STAMP_SOURCES,
+            details=(
+                "driver: the state's header stamp. receipt: the system clock when the state "
+                "arrives, for a driver whose stamps are zero or do not advance."
+            ),
         ),
     )
     joints: list[str] | tuple[str, ...] = field(
         default_factory=lambda: [""],
         metadata=param(
-            description=(
-                "the driver's name of each model joint, in the model's joint order ([''] = the "
-                "model's names); other joints in the state (grippers, a gimbal) are ignored"
-            )
+            description="the driver's name of each model joint, in model order; [''] = the model's",
+            details=("Other joints in the state (grippers, a gimbal) are ignored."),
         ),
     )
     signs: list[float] | tuple[float, ...] = field(
         default_factory=lambda: [1.0],
         metadata=param(
             description=(
-                "+1 or -1 per model joint (one value: every joint): model q = sign * scale * "
-                "driver q; efforts and commands alike"
+                "+1 or -1 per model joint (or one for all): model q = sign * scale * driver q"
             ),
             bounds=(-1.0, 1.0),
+            details="Efforts and commands alike.",
         ),
     )
     scale: float = field(
@@ -110,12 +107,12 @@ class StateSettings:
     velocity: str = field(
         default="auto",
         metadata=param(
-            description=(
-                "joint velocity handed on: the driver's (driver), the backward difference of the "
-                "positions low-passed at velocity_cutoff_hz (difference), or the driver's where "
-                "its state has one (auto)"
-            ),
+            description=("joint velocity handed on: the driver's, a filtered difference, or auto"),
             choices=VELOCITY_SOURCES,
+            details=(
+                "driver: the driver's. difference: the backward difference of the positions, "
+                "low-passed at velocity_cutoff_hz. auto: the driver's where its state has one."
+            ),
         ),
     )
     velocity_cutoff_hz: float = field(
@@ -131,22 +128,20 @@ class StateSettings:
     effort: str = field(
         default="",
         metadata=param(
-            description=(
-                "effort of [k-1, k) in the loop's joint_states: what the bridge commanded "
-                "(commanded) or what the driver reports (driver); '' = the profile's"
-            ),
+            description=("effort of [k-1, k) in the loop's joint_states; '' = the profile's"),
             choices=("", *EFFORT_SOURCES),
+            details=("commanded: what the bridge commanded; driver: what the driver reports."),
         ),
     )
     timeout_s: float = field(
         default=0.01,
         metadata=param(
             description=(
-                "watchdog: zero command when no driver state came for this long (wall clock); a "
-                "stale state is not rendered"
+                "watchdog: zero command when no driver state came for this long (wall clock)"
             ),
             unit="s",
             bounds=(0.001, 1.0),
+            details="A stale state is not rendered.",
         ),
     )
 
@@ -164,21 +159,23 @@ class CommandSettings:
     type: str = field(
         default="",
         metadata=param(
-            description=(
-                "float64_multi_array (joint efforts), wrench_stamped, wrench or vector3 (a force "
-                "in the base frame); '' = the profile's"
-            ),
+            description=("the command's type: joint efforts, or a force; '' = the profile's"),
             choices=("", *COMMAND_TYPES),
+            details=(
+                "float64_multi_array: joint efforts; wrench_stamped, wrench or vector3: a force in "
+                "the base frame."
+            ),
         ),
     )
     reliability: str = field(
         default="reliable",
         metadata=param(
-            description=(
-                "QoS reliability of the publisher: reliable serves both kinds of subscription "
-                "(forward_command_controller's is reliable)"
-            ),
+            description="QoS reliability of the publisher",
             choices=RELIABILITY,
+            details=(
+                "reliable serves both kinds of subscription (forward_command_controller's is "
+                "reliable)."
+            ),
         ),
     )
     depth: int = field(
@@ -188,9 +185,12 @@ class CommandSettings:
         default_factory=lambda: [""],
         metadata=param(
             description=(
-                "float64_multi_array: the controller's joints parameter in its order (driver "
-                "names; a joint the model lacks gets 0); [''] = state.joints"
-            )
+                "float64_multi_array: the controller's joints, in order; [''] = state.joints"
+            ),
+            details=(
+                "The controller's joints parameter in its order (driver names); a joint the model "
+                "lacks gets 0."
+            ),
         ),
     )
     frame_id: str = field(
@@ -205,11 +205,13 @@ class CommandSettings:
         default=-1,
         metadata=param(
             description=(
-                "driver cycles from a command's arrival to the cycle it acts in: 1 for "
-                "ros2_control (written at its next update), 0 for a driver applying it on arrival; "
-                "-1 = the profile's"
+                "driver cycles from a command's arrival to the cycle it acts in; -1 = profile's"
             ),
             bounds=(-1, 4),
+            details=(
+                "1 for ros2_control (written at its next update), 0 for a driver applying it on "
+                "arrival."
+            ),
         ),
     )
 
@@ -221,11 +223,9 @@ class FrameSettings:
     axes: list[int] | tuple[int, ...] = field(
         default_factory=lambda: [0, 1, 2],
         metadata=param(
-            description=(
-                "force command and pose state: the driver's axis (0 x, 1 y, 2 z) of each model "
-                "base axis"
-            ),
+            description="the driver's axis (0 x, 1 y, 2 z) of each model base axis",
             bounds=(0, 2),
+            details="For the force command and the pose state.",
         ),
     )
     signs: list[float] | tuple[float, ...] = field(

@@ -31,45 +31,40 @@ class SafetySettings:
     command_limits: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            description=(
-                "force clamp per command element, N (Cartesian) or N / N m (joints), before "
-                "command.scale: one value for every element or one each. Required: [] refuses to "
-                "start"
-            ),
+            description=("force clamp per command element, one value or one each; required"),
             unit="N",
             bounds=(0.0, 1e4),
+            details=(
+                "N (Cartesian) or N / N m (joints), before command.scale. [] refuses to start."
+            ),
         ),
     )
     rate_limit: list[float] | tuple[float, ...] = field(
         default_factory=lambda: [2000.0],
         metadata=param(
             description=(
-                "largest change of each command element per second (one value or one each); 0 = "
-                "none. A stop to zero is never slowed"
+                "largest change of each command element per second, one or one each; 0 = none"
             ),
             unit="N/s",
             bounds=(0.0, 1e7),
+            details="A stop to zero is never slowed.",
         ),
     )
     command_timeout_s: float = field(
         default=0.005,
         metadata=param(
-            description=(
-                "watchdog: zero command when the loop's command stopped for this long, counted in "
-                "driver states"
-            ),
+            description=("watchdog: zero command when the loop's command stopped for this long"),
             unit="s",
             bounds=(0.0005, 1.0),
+            details="Counted in driver states.",
         ),
     )
     deadman: str = field(
         default="none",
         metadata=param(
-            description=(
-                "dead-man input: none, a std_msgs/Bool topic or a sensor_msgs/Joy button; force "
-                "only while held (never seen = released)"
-            ),
+            description=("dead-man input: none, a std_msgs/Bool topic or a sensor_msgs/Joy button"),
             choices=DEADMAN_TYPES,
+            details="Force only while held; never seen = released.",
         ),
     )
     deadman_topic: str = field(default="", metadata=param(description="the dead-man's topic"))
@@ -111,11 +106,9 @@ class RunSettings:
     wait_for: list[str] | tuple[str, ...] = field(
         default_factory=lambda: ["environment_node", "observer_node", "controller_node"],
         metadata=param(
-            description=(
-                "loop nodes (in this namespace, or fully qualified) that must be up before the "
-                "driver's states go to the loop; until then the driver gets zero"
-            ),
+            description=("loop nodes that must be up before the driver's states go to the loop"),
             read_only=True,
+            details=("In this namespace, or fully qualified. Until then the driver gets zero."),
         ),
     )
     start_delay_s: float = field(
@@ -143,22 +136,22 @@ class RunSettings:
     stats_file: str = field(
         default="",
         metadata=param(
-            description=(
-                "write the bridge's counts (JSON) here at shutdown: states, commands on time, "
-                "refused, clamped, trips"
-            ),
+            description="write the bridge's counts (JSON) here at shutdown",
             read_only=True,
+            details="States, commands on time, refused, clamped, trips.",
         ),
     )
     external_torque_topic: str = field(
         default="",
         metadata=param(
             description=(
-                "republish the observer's effort_estimate here as sensor_msgs/JointState (name and "
-                "effort) in the driver's joint names and signs, as franka_ros2's "
-                "external_joint_torques; '' = off"
+                "republish the observer's effort_estimate here, in the driver's joints; '' = off"
             ),
             read_only=True,
+            details=(
+                "As sensor_msgs/JointState (name and effort) in the driver's joint names and "
+                "signs, as franka_ros2's external_joint_torques."
+            ),
         ),
     )
 
@@ -170,13 +163,14 @@ class DriverProfile:
     profile: str = field(
         default=PROFILES[0],
         metadata=param(
-            description=(
-                "the driver's kind: ros2_control_effort (joint_state_broadcaster and an effort "
-                "forward_command_controller), cartesian_wrench (a Touch-like Cartesian force "
-                "input), suite (the suite's own contract)"
-            ),
+            description="the driver's kind: the defaults of the command type, delay and effort",
             choices=PROFILES,
             read_only=True,
+            details=(
+                "ros2_control_effort: joint_state_broadcaster and an effort "
+                "forward_command_controller. cartesian_wrench: a Touch-like Cartesian force input. "
+                "suite: the suite's own contract."
+            ),
         ),
     )
 

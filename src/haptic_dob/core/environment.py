@@ -44,7 +44,7 @@ class VirtualWall:
     )
     normal: Vec3 = field(
         default=(1.0, 0.0, 0.0),
-        metadata=param(description="wall normal from free space into the wall (x, y, z), non-zero"),
+        metadata=param(description="normal pointing into the wall (x, y, z), non-zero"),
     )
     two_sided: bool = field(
         default=False,

@@ -78,23 +78,19 @@ class Excitation:
     high_hz: float = field(
         default=8.0,
         metadata=param(
-            description=(
-                "chirp and multisine: highest frequency (identification's filters bias the mass "
-                "upward above about 10 Hz)"
-            ),
+            description="chirp and multisine: highest frequency",
             unit="Hz",
             bounds=(1e-3, 200.0),
+            details=("Identification's filters bias the mass upward above about 10 Hz."),
         ),
     )
     period_s: float = field(
         default=10.0,
         metadata=param(
-            description=(
-                "chirp: one sweep (then it repeats); multisine: its period (frequency step "
-                "1/period)"
-            ),
+            description="chirp: one sweep (then it repeats); multisine: its period",
             unit="s",
             bounds=(0.1, 1e4),
+            details="The multisine's frequency step is 1/period.",
         ),
     )
     along: str = field(
@@ -109,12 +105,10 @@ class Excitation:
     hold_n_per_m: float = field(
         default=0.0,
         metadata=param(
-            description=(
-                "stiffness of an isotropic spring toward hold_at (0: none), keeping a device that "
-                "nothing else holds in its workspace"
-            ),
+            description="stiffness of an isotropic spring toward hold_at; 0 = none",
             unit="N/m",
             bounds=(0.0, 1e4),
+            details="It keeps a device that nothing else holds in its workspace.",
         ),
     )
     hold_at: tuple[float, float, float] = field(

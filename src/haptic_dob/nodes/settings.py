@@ -42,17 +42,17 @@ class LoopInputs:
     input_reliability: str = field(
         default="best_effort",
         metadata=param(
-            description=(
-                "QoS reliability of this node's loop inputs: reliable (a one-off message such as "
-                "ros2 topic pub --once is asked for again and arrives while its publisher lives; "
-                "the default of the device's effort_command) or best_effort (no "
-                "acknowledgements, the default of the sensor streams: nodes in separate "
-                "processes cycle faster, see BENCHMARKS.md, and a message sent before the reader "
-                "matched its writer can be lost). Nodes sharing a process hand values over in "
-                "process either way"
-            ),
+            description="QoS reliability of this node's loop inputs",
             choices=INPUT_RELIABILITY,
             read_only=True,
+            details=(
+                "reliable: a one-off message (ros2 topic pub --once) is asked for again and "
+                "arrives while its publisher lives; the default of a device's effort_command. "
+                "best_effort: no acknowledgements, the default of the sensor streams; nodes in "
+                "separate processes cycle faster (BENCHMARKS.md), and a message sent before the "
+                "reader matched its writer can be lost. Nodes sharing a process hand values over "
+                "in process either way."
+            ),
         ),
     )
 
@@ -69,38 +69,43 @@ class CommandInputSettings:
     command_source: str = field(
         default="controller_node",
         metadata=param(
-            description=(
-                "the node whose effort_command moves the device from another process: a name in "
-                "this namespace, or fully qualified (commands handed over in this process, the "
-                "loop composed, always do)"
-            ),
+            description=("the node whose effort_command moves the device from another process"),
             read_only=True,
+            details=(
+                "A name in this namespace, or fully qualified. Commands handed over in this "
+                "process (the loop composed) always do."
+            ),
         ),
     )
     command_token: str = field(
         default="",
         metadata=param(
             description=(
-                "this session's command token: a command from another process moves the device "
-                "only when its layout label carries it (effort@<stamp>#<token>); haptic-launch "
-                "writes a fresh one for a device and its controller at every launch. '' = the "
-                "token of command_source's commands, taken while the graph shows that node (name "
-                "and GID) as the only publisher. Not a secret from anyone on the network "
-                "(docs/safety.md)"
+                "this session's command token; '' = the one command_source's commands carry"
             ),
             read_only=True,
+            details=(
+                "A command from another process moves the device only when its layout label "
+                "carries it (effort@<stamp>#<token>); haptic-launch writes a fresh one for a "
+                "device and its controller at every launch. '' = the token of command_source's "
+                "commands, taken while the graph shows that node (name and GID) as the only "
+                "publisher. Not a secret from anyone on the network (docs/safety.md)."
+            ),
         ),
     )
     open_command_input: bool = field(
         default=False,
         metadata=param(
             description=(
-                "take effort_command from any publisher (bench work: ros2 topic pub, a tool of "
-                "your own); false: only command_source's, the others refused, counted in "
-                "/diagnostics and named once each in the log. At start-up only: no one on the "
-                "network can open it with ros2 param set"
+                "take effort_command from any publisher (bench work); false: command_source's"
             ),
             read_only=True,
+            details=(
+                "Bench work: ros2 topic pub, a tool of your own. False: only command_source's "
+                "commands move the device; the others are refused, counted in /diagnostics and "
+                "named once each in the log. At start-up only: no one on the network can open it "
+                "with ros2 param set."
+            ),
         ),
     )
 
@@ -113,12 +118,13 @@ class CommandOutputSettings:
         default="",
         metadata=param(
             description=(
-                "the token this node's effort_command carries in its layout label "
-                "(effort@<stamp>#<token>), by which the device takes commands from another "
-                "process; haptic-launch writes the session's; '' = a fresh random one at every "
-                "start"
+                "the token this node's effort_command carries; '' = a new one at every start"
             ),
             read_only=True,
+            details=(
+                "Carried in the command's layout label (effort@<stamp>#<token>), by which the "
+                "device takes commands from another process; haptic-launch writes the session's."
+            ),
         ),
     )
 
@@ -130,28 +136,29 @@ class ProcessSettings:
     cpu_affinity: list[int] | tuple[int, ...] = field(
         default_factory=list,
         metadata=param(
-            description=(
-                "CPUs this node's process runs on, every thread (as ros2_control's "
-                "cpu_affinity); [] = wherever the system schedules it. haptic-launch --pin fills "
-                "it per node"
-            ),
+            description=("CPUs this node's process runs on, every thread; [] = not pinned"),
             read_only=True,
+            details=(
+                "As ros2_control's cpu_affinity; [] = wherever the system schedules it. "
+                "haptic-launch --pin fills it per node."
+            ),
         ),
     )
     cpu_latency_us: int = field(
         default=-1,
         metadata=param(
             description=(
-                "while this process runs, CPUs use only idle states whose advertised exit "
-                "latency is at most this (Linux PM QoS request on /dev/cpu_dma_latency, held "
-                "open; needs write access to it, root as a rule; a node that cannot make it does "
-                "not start): 0 = idle CPUs poll and wake at once (costs power; on a virtual "
-                "machine only 0 helps). -1 = no request. haptic-launch --cpu-latency sets it on "
-                "every loop node"
+                "CPU idle states' largest exit latency while it runs (PM QoS); -1 = no request"
             ),
             unit="us",
             bounds=(-1, 1_000_000),
             read_only=True,
+            details=(
+                "A Linux PM QoS request on /dev/cpu_dma_latency, held open while the process runs; "
+                "it needs write access to it (root as a rule), and a node that cannot make it does "
+                "not start. 0 = idle CPUs poll and wake at once (costs power; on a virtual machine "
+                "only 0 helps). haptic-launch --cpu-latency sets it on every loop node."
+            ),
         ),
     )
 
@@ -171,12 +178,12 @@ class ControllerSettings:
     warm_inputs: bool = field(
         default=True,
         metadata=param(
-            description=(
-                "subscribe to every mode's force input, so a switch to CL or DOB finds it "
-                "flowing (false: only the start mode's input; cheaper; a switch to another mode "
-                "is refused)"
-            ),
+            description=("subscribe to every mode's force input (false: the start mode's only)"),
             read_only=True,
+            details=(
+                "So a switch to CL or DOB finds its input flowing. False is cheaper, but a switch "
+                "to another mode is then refused."
+            ),
         ),
     )
     fallback: str = field(
@@ -189,12 +196,13 @@ class ControllerSettings:
     input_timeout_s: float = field(
         default=0.02,
         metadata=param(
-            description=(
-                "the mode's force input counts as stopped when its newest sample is this much "
-                "sample time older than the cycle"
-            ),
+            description=("sample time after which the mode's force input counts as stopped"),
             unit="s",
             bounds=(0.001, 10.0),
+            details=(
+                "The input counts as stopped when its newest sample is this much sample time older "
+                "than the cycle."
+            ),
         ),
     )
 

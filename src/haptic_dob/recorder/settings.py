@@ -37,34 +37,38 @@ class RecorderSettings:
     log_time: str = field(
         default="session",
         metadata=param(
-            description=(
-                "bag time of each message: session = the session's time (a loop message's own "
-                "stamp, anything else the newest stamp or /clock received; as ros2 bag record "
-                "--use-sim-time), receive = the wall-clock receive time (as ros2 bag record)"
-            ),
+            description=("bag time of each message: the session's time, or the receive time"),
             choices=LOG_TIMES,
             read_only=True,
+            details=(
+                "session: the session's time (a loop message's own stamp, anything else the newest "
+                "stamp or /clock received; as ros2 bag record --use-sim-time). receive: the "
+                "wall-clock receive time (as ros2 bag record)."
+            ),
         ),
     )
     topics: list[str] | tuple[str, ...] = field(
         default_factory=lambda: list(DEFAULT_TOPICS),
         metadata=param(
-            description=(
-                "topics to record: session topics and /parameter_events by name, others as "
-                "NAME:pkg/msg/Type"
-            ),
+            description=("topics to record: session topics by name, others as NAME:pkg/msg/Type"),
             read_only=True,
+            details=(
+                "Session topics and /parameter_events by name, any other topic as "
+                "NAME:pkg/msg/Type."
+            ),
         ),
     )
     namespaces: list[str] | tuple[str, ...] = field(
         default_factory=lambda: [""],
         metadata=param(
             description=(
-                "namespaces whose nodes it snapshots and whose devices it reports its progress "
-                "to (<ns>/recorder/progress); [''] = its own (a teleoperation graph: [/master, "
-                "/slave])"
+                "namespaces whose nodes it snapshots and devices it reports to; [''] = its own"
             ),
             read_only=True,
+            details=(
+                "It reports its progress on <ns>/recorder/progress. A teleoperation graph: "
+                "[/master, /slave]."
+            ),
         ),
     )
     duration_s: float = field(
@@ -97,12 +101,15 @@ class RecorderSettings:
         default=2.0,
         metadata=param(
             description=(
-                "warn when a node has not answered the parameter snapshot after this long; it is "
-                "still asked, the question sent again every this long (a response may be lost)"
+                "warn when a node has not answered the parameter snapshot after this long"
             ),
             unit="s",
             bounds=(0.1, 60.0),
             read_only=True,
+            details=(
+                "The node is still asked, the question sent again every this long (a response may "
+                "be lost)."
+            ),
         ),
     )
     drain_timeout_s: float = field(

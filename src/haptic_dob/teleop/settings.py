@@ -45,10 +45,10 @@ class TeleopSettings:
         default="estimate",
         metadata=param(
             description=(
-                "position_force: the slave force sent back, the observer's estimate or the wrist "
-                "sensor's reading"
+                "position_force: the slave force sent back (observer's or wrist sensor's)"
             ),
             choices=FORCE_SOURCES,
+            details=("estimate: the observer's estimate; sensor: the wrist sensor's reading."),
         ),
     )
     rotation: tuple[float, ...] = field(
@@ -69,12 +69,10 @@ class TeleopSettings:
     master_max_force_n: float = field(
         default=4.0,
         metadata=param(
-            description=(
-                "the largest force the master renders (its controller's max_force_n, master "
-                "units): the channel books no more than it renders"
-            ),
+            description=("the largest force the master renders (its controller's max_force_n)"),
             unit="N",
             bounds=(1e-3, 1e4),
+            details=("In master units: the channel books no more than the master renders."),
         ),
     )
     coupling_n_per_m: float = field(

@@ -39,7 +39,7 @@ def contact_specs() -> list[ParamSpec]:
         "contact.",
         read_only=True,
         defaults=NO_WALL,
-        about="arms, the wall the tip touches (0 stiffness: none)",
+        about="arm contact (K = 0: none)",
     )
     return [s for s in specs if s.name != "contact.two_sided"]
 

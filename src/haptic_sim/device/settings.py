@@ -67,22 +67,20 @@ class DeviceSafety:
     command_timeout_s: float = field(
         default=0.005,
         metadata=param(
-            description=(
-                "realtime watchdog: zero effort when no valid command came for this long, "
-                "counted in the samples the device sent (a stall of the device's own process "
-                "does not count)"
-            ),
+            description=("realtime watchdog: zero effort after this long without a valid command"),
             unit="s",
             bounds=(0.0005, 1.0),
+            details=(
+                "Counted in the samples the device sent: a stall of the device's own process does "
+                "not count."
+            ),
         ),
     )
     effort_limits: list[float] | tuple[float, ...] = field(
         default_factory=lambda: [0.0],
         metadata=param(
-            description=(
-                "per-joint effort limit (N or N m) applied to every command, at most the "
-                "actuator's saturation; [0.0] = the actuator's saturation"
-            ),
+            description="per-joint effort limit (N or N m) on every command; [0.0] = saturation",
+            details=("At most the actuator's saturation; [0.0] = the actuator's saturation."),
         ),
     )
 
@@ -94,12 +92,13 @@ class DeviceClock:
     clock_mode: str = field(
         default="lockstep",
         metadata=param(
-            description=(
-                "lockstep: advance when command k arrived (stamps k * T); realtime: tick at "
-                "rate_hz on the wall clock (stamps: the system clock when each sample is taken)"
-            ),
+            description=("lockstep: step when command k arrived; realtime: tick on the wall clock"),
             choices=CLOCK_MODES,
             read_only=True,
+            details=(
+                "lockstep: sample k is stamped k * T. realtime: ticks at rate_hz on the wall "
+                "clock, each sample stamped with the system clock when it is taken."
+            ),
         ),
     )
 
@@ -111,47 +110,45 @@ class DeviceSchedule:
     lockstep_timeout_s: float = field(
         default=2.0,
         metadata=param(
-            description=(
-                "lockstep: warn and re-send a sample after this long without its command (a "
-                "best-effort input can drop a sample on a loaded machine)"
-            ),
+            description=("lockstep: warn and re-send a sample after this long without its command"),
             unit="s",
             bounds=(0.01, 3600.0),
+            details="A best-effort input can drop a sample on a loaded machine.",
         ),
     )
     wait_for: list[str] | tuple[str, ...] = field(
         default_factory=lambda: list(DEFAULT_WAIT_FOR),
         metadata=param(
-            description=(
-                "nodes that must be up before sample 0, in both clock modes: a name in this "
-                "namespace, or fully qualified (/rosbag2_recorder); realtime with []: tick at "
-                "once, the watchdog holds zero effort until commands come"
-            ),
+            description="nodes that must be up before sample 0, in either clock mode",
             read_only=True,
+            details=(
+                "A name in this namespace, or fully qualified (/rosbag2_recorder). realtime with "
+                "[]: tick at once, the watchdog holding zero effort until commands come."
+            ),
         ),
     )
     start_with: list[str] | tuple[str, ...] = field(
         default_factory=list,
         metadata=param(
             description=(
-                "devices this one starts its clock with, fully qualified (/slave/device_node): "
-                "sample 0 waits until each has built its simulation (its joint_states publisher "
-                "is up), so that the two sides of a teleoperation in real time tick from the "
-                "same moment"
+                "devices this one starts its clock with, fully qualified (/slave/device_node)"
             ),
             read_only=True,
+            details=(
+                "Sample 0 waits until each has built its simulation (its joint_states publisher is "
+                "up), so that the two sides of a teleoperation in real time tick from the same "
+                "moment."
+            ),
         ),
     )
     start_delay_s: float = field(
         default=0.5,
         metadata=param(
-            description=(
-                "settle time between the wait_for graph being up and sample 0 (endpoint "
-                "matching between the other nodes)"
-            ),
+            description="settle time between the wait_for graph being up and sample 0",
             unit="s",
             bounds=(0.0, 60.0),
             read_only=True,
+            details="For the endpoint matching between the other nodes.",
         ),
     )
     stats_file: str = field(

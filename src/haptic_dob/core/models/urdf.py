@@ -146,44 +146,44 @@ class UrdfOptions:
     viscous_n_m_s_per_rad: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            description=(
-                "viscous joint friction (N s/m for a prismatic joint), one value for every joint "
-                "or one per joint; [] = each joint's <dynamics damping> from the URDF"
-            ),
+            description=("viscous joint friction, one value or one per joint; [] = the URDF's"),
             unit="N m s/rad",
             bounds=(0.0, 1e3),
+            details=(
+                "N s/m for a prismatic joint. [] = each joint's <dynamics damping> from the URDF."
+            ),
         ),
     )
     coulomb_n_m: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            description=(
-                "Coulomb joint friction (N for a prismatic joint), one value for every joint or "
-                "one per joint; [] = each joint's <dynamics friction> from the URDF"
-            ),
+            description=("Coulomb joint friction, one value or one per joint; [] = the URDF's"),
             unit="N m",
             bounds=(0.0, 1e3),
+            details=(
+                "N for a prismatic joint. [] = each joint's <dynamics friction> from the URDF."
+            ),
         ),
     )
     coulomb_speed_rad_per_s: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
             description=(
-                "speed over which the Coulomb friction turns, Fc tanh(q'/v_c) (m/s for a prismatic "
-                "joint), one value for every joint or one per joint; [] or 0 = Fc sgn(q'). An "
-                "observer's model (haptic-identify --urdf fits it); a simulated arm smooths by its "
-                "own physics step and refuses it"
+                "speed over which Coulomb friction turns, Fc tanh(q'/v_c); [] or 0 = Fc sgn(q')"
             ),
             unit="rad/s",
             bounds=(0.0, 10.0),
+            details=(
+                "m/s for a prismatic joint; one value for every joint or one per joint. An "
+                "observer's model (haptic-identify --urdf fits it); a simulated arm smooths by its "
+                "own physics step and refuses it."
+            ),
         ),
     )
     payload_kg: float = field(
         default=0.0,
         metadata=param(
-            description=(
-                "a point mass at tip_frame's origin that the URDF does not have (a handle, a tool)"
-            ),
+            description="a point mass at tip_frame's origin that the URDF lacks (a handle, a tool)",
             unit="kg",
             bounds=(0.0, 100.0),
         ),

@@ -31,23 +31,21 @@ class ObserverSettings:
     output_limit: float = field(
         default=0.0,
         metadata=param(
-            description=(
-                "clip of the estimated joint effort; 0 = no clip (the slide sessions use the "
-                "thesis's 4 N)"
-            ),
+            description="clip of the estimated joint effort; 0 = no clip",
             unit="N or N m",
             bounds=(0.0, 1e6),
+            details="The slide sessions use the thesis's 4 N.",
         ),
     )
     kind: str = field(
         default="dob",
         metadata=param(
             description=(
-                "the disturbance observer (lag D/c per joint) or the generalized-momentum observer "
-                "(lag 1/gain on every joint)"
+                "observer: dob (lag D/c per joint) or momentum (lag 1/gain on every joint)"
             ),
             choices=OBSERVER_KINDS,
             read_only=True,
+            details=("dob: the disturbance observer; momentum: the generalized-momentum observer."),
         ),
     )
 
