@@ -9,11 +9,12 @@ Parameter groups, each a frozen dataclass read by ``build`` (``runtime.params``)
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 from haptic_dob.runtime.params import build, param
+from haptic_msgs_py.topics import EFFORT_COMMAND, JOINT_STATES
 
 PROFILES = ("ros2_control_effort", "cartesian_wrench", "suite")
 STATE_TYPES = ("joint_states", "pose")
@@ -298,3 +299,23 @@ class DriverSettings:
             raise ValueError("state.signs and frame.signs take +1 or -1 only")
         if self.state.type == "pose" and self.effort == "driver":
             raise ValueError("a pose state carries no effort: state.effort must be commanded")
+
+    def check_apart(self, resolve: Callable[[str], str]) -> None:
+        """``ValueError`` when the driver's state or command topic is the loop's own
+        (``resolve``: a topic's name as the bridge's node resolves it)."""
+        ours = {resolve(t) for t in (JOINT_STATES, EFFORT_COMMAND)}
+        for topic in (self.state.topic, self.command.topic):
+            if resolve(topic) in ours:
+                raise ValueError(
+                    f"the driver's {topic} is the loop's own topic here: run the loop in a "
+                    "namespace of its own (-r __ns:=/haptic) and name the driver's topics "
+                    "absolutely (/fd/joint_states)"
+                )
+
+    def describe(self) -> str:
+        """One line: the profile, the state and the command topics with their types and QoS."""
+        c, s = self.command, self.state
+        return (
+            f"a {self.profile} driver: state {s.topic} ({s.type}, {s.reliability}), "
+            f"command {c.topic} ({c.type}, {c.reliability})"
+        )
