@@ -44,7 +44,10 @@ class VirtualWall:
     )
     normal: Vec3 = field(
         default=(1.0, 0.0, 0.0),
-        metadata=param(description="normal pointing into the wall (x, y, z), non-zero"),
+        metadata=param(
+            description="normal pointing into the wall (x, y, z), non-zero",
+            details="From free space into the wall; of any length but zero (it is normalised).",
+        ),
     )
     two_sided: bool = field(
         default=False,
