@@ -63,16 +63,17 @@ def node_values(sections: Mapping[str, Mapping[str, Any]], ns: str, node: str) -
 
 
 def load_teleop_sections(path: str | Path) -> dict[str, dict[str, Any]]:
-    """The YAML's sections, a relative ``urdf_path`` taken from the YAML's own directory (the
-    installed ``teleop_sim.yaml`` names ``urdf/arm7.urdf`` beside it)."""
+    """The YAML's sections, a relative ``urdf_path`` or ``slave.trajectory_path`` taken from the
+    YAML's own directory (the installed ``teleop_sim.yaml`` names ``urdf/arm7.urdf`` beside it)."""
     from haptic_dob.runtime.params import load_sections
 
     sections = load_sections(path)
     here = Path(path).resolve().parent
     for values in sections.values():
-        given = values.get("urdf_path")
-        if isinstance(given, str) and given and not Path(given).is_absolute():
-            values["urdf_path"] = str(here / given)
+        for key in ("urdf_path", "slave.trajectory_path"):
+            given = values.get(key)
+            if isinstance(given, str) and given and not Path(given).is_absolute():
+                values[key] = str(here / given)
     return sections
 
 

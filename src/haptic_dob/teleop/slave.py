@@ -18,6 +18,11 @@ far above the bandwidth, where the 1 kHz loop chatters at 500 Hz. Per-joint gain
 are diagonal.
 ``q_d`` and ``q_0`` start at the first sample's joint positions. In contact the target runs into
 the wall while the arm stops at it; the joints' springs push with the difference.
+
+With ``trajectory_path`` (an excitation file, ``haptic_dob.identification.arm_excitation``) the
+slave plays it instead (``play``): ``tau = K (q_d(t) - q) + B (q_d'(t) - q') + G(q)``, t from the
+first sample, the difference between the arm's first posture and the trajectory's start fading
+out over ``BLEND_S`` (a cosine); no point is tracked.
 """
 
 from __future__ import annotations
@@ -30,7 +35,11 @@ import numpy as np
 from haptic_dob.core.control import saturate
 from haptic_dob.core.models.base import DeviceModel, Vec
 from haptic_dob.core.validation import nonnegative, positive
+from haptic_dob.identification.arm_excitation import FourierExcitation
 from haptic_dob.runtime.params import param
+
+#: how long the difference between the arm's first posture and a trajectory's start fades (s)
+BLEND_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -74,6 +83,13 @@ class SlaveImpedance:
     gravity_compensation: bool = field(
         default=True, metadata=param("add the model's gravity effort")
     )
+    trajectory_path: str = field(
+        default="",
+        metadata=param(
+            "an excitation trajectory file to play (joint targets by time, haptic-excite "
+            "writes one); '' = track pose_desired"
+        ),
+    )
 
     def __post_init__(self) -> None:
         positive("bandwidth_hz", self.bandwidth_hz)
@@ -94,9 +110,16 @@ class SlaveController:
         model: the slave's model (its kinematics, inertia at the start pose, gravity, limits).
         settings: gains and IK settings.
         dt: the control period (s).
+        trajectory: a trajectory to play (default: ``settings.trajectory_path``'s, if any).
     """
 
-    def __init__(self, model: DeviceModel, settings: SlaveImpedance, dt: float) -> None:
+    def __init__(
+        self,
+        model: DeviceModel,
+        settings: SlaveImpedance,
+        dt: float,
+        trajectory: FourierExcitation | None = None,
+    ) -> None:
         self.model = model
         self.settings = settings
         self.dt = positive("dt", dt)
@@ -116,6 +139,14 @@ class SlaveController:
         self.q_0: Vec = np.zeros(n)  # the posture the redundant joints return to
         self.K = np.zeros((n, n))  # joint stiffness (N m/rad)
         self.B = np.zeros((n, n))  # joint damping (N m s/rad)
+        self.trajectory = trajectory
+        if trajectory is None and settings.trajectory_path:
+            self.trajectory = FourierExcitation.load(settings.trajectory_path)
+        if self.trajectory is not None and self.trajectory.joints != tuple(model.joint_names):
+            raise ValueError(
+                f"slave.trajectory_path: the trajectory moves {list(self.trajectory.joints)}, "
+                f"the model's joints are {list(model.joint_names)}"
+            )
 
     def start(self, q: Vec) -> None:
         """Take ``q`` as the joint target, the posture and the pose the gains are set at."""
@@ -151,11 +182,27 @@ class SlaveController:
         self.q_d = q_d
         return self.joint_command(q, qd, q_d)
 
-    def joint_command(self, q: Vec, qd: Vec, q_d: Vec) -> list[float]:
-        """``K (q_d - q) - B q' + G(q)``, saturated (N m or N): the impedance around ``q_d``."""
+    def play(self, q: Vec, qd: Vec, t_s: float) -> list[float]:
+        """Joint efforts (N m or N) playing the trajectory at ``t_s`` (s since the first sample)."""
+        traj = self.trajectory
+        if traj is None:
+            raise ValueError("no trajectory to play (slave.trajectory_path is '')")
         if self.q_d is None:
             self.start(q)
-        tau = self.K @ (q_d - q) - self.B @ qd
+        (q_d,), (v_d,), _ = traj.motion(np.array([t_s]))
+        if t_s < BLEND_S:
+            gap = self.q_0 - np.asarray(traj.start)
+            phase = math.pi * t_s / BLEND_S
+            q_d = q_d + (0.5 + 0.5 * math.cos(phase)) * gap
+            v_d = v_d - 0.5 * math.pi / BLEND_S * math.sin(phase) * gap
+        return self.joint_command(q, qd, q_d, v_d)
+
+    def joint_command(self, q: Vec, qd: Vec, q_d: Vec, qd_d: Vec | None = None) -> list[float]:
+        """``K (q_d - q) + B (q_d' - q') + G(q)``, saturated (N m or N): the impedance around
+        ``q_d`` (``q_d'`` = 0 when not given)."""
+        if self.q_d is None:
+            self.start(q)
+        tau = self.K @ (q_d - q) - self.B @ (qd if qd_d is None else qd - qd_d)
         if self.settings.gravity_compensation:
             tau += self.model._gravity(q)
         out: list[float] = tau.tolist()

@@ -33,7 +33,10 @@ class UrdfModel(PinocchioModel):
         coulomb: Coulomb joint friction (N m or N), scalar or per joint; None: each joint's
             ``<dynamics friction>`` from the URDF.
         coulomb_speed: the speed (rad/s or m/s) over which the Coulomb friction turns, scalar or
-            per joint: ``Fc tanh(q' / v_c)``; 0 (the default): ``Fc sgn(q')``.
+            per joint: ``Fc tanh(q' / v_c)``, 0: ``Fc sgn(q')``; None: each joint's
+            ``<haptic_dob:dynamics coulomb_speed>`` from the URDF (0 where it has none).
+        armature: rotor inertia reflected to each joint (kg m^2 or kg), scalar or per joint;
+            None: each joint's ``<haptic_dob:dynamics armature>`` from the URDF (0 where none).
 
     Raises ``ValueError`` with a clear message for a bad URDF, an unknown frame or joint, or a
     joint that cannot be a coordinate (floating, planar, a mimic joint named in ``joint_names``).
@@ -48,7 +51,8 @@ class UrdfModel(PinocchioModel):
         gravity: bool = True,
         viscous: float | Sequence[float] | None = None,
         coulomb: float | Sequence[float] | None = None,
-        coulomb_speed: float | Sequence[float] = 0.0,
+        coulomb_speed: float | Sequence[float] | None = None,
+        armature: float | Sequence[float] | None = None,
     ) -> None:
         if not str(tip_frame):
             raise ValueError("tip_frame must name a frame of the URDF, got ''")
@@ -56,6 +60,9 @@ class UrdfModel(PinocchioModel):
         self.tip_frame = str(tip_frame)
         #: per-joint effort limits from the URDF's <limit effort=...> (0 where none)
         self.effort_limits = arm.effort_limits
+        #: per-joint position limits (rad or m; -inf, inf where none) and speed limits (0: none)
+        self.position_limits = arm.position_limits
+        self.velocity_limits = arm.velocity_limits
         super().__init__(
             arm.model,
             arm.frame_id,
@@ -64,7 +71,8 @@ class UrdfModel(PinocchioModel):
             gravity=gravity,
             viscous=arm.damping if viscous is None else viscous,
             coulomb=arm.friction if coulomb is None else coulomb,
-            coulomb_speed=coulomb_speed,
+            coulomb_speed=arm.coulomb_speed if coulomb_speed is None else coulomb_speed,
+            armature=arm.armature if armature is None else armature,
         )
 
     def __repr__(self) -> str:
@@ -111,12 +119,14 @@ class UrdfSettings:
             gravity=opts.gravity,
             viscous=_friction(opts.viscous_n_m_s_per_rad),
             coulomb=_friction(opts.coulomb_n_m),
-            coulomb_speed=_friction(opts.coulomb_speed_rad_per_s) or 0.0,
+            coulomb_speed=_friction(opts.coulomb_speed_rad_per_s),
+            armature=_friction(opts.armature_kg_m2),
         )
 
 
 def _friction(values: Sequence[float]) -> float | list[float] | None:
-    """None for [] (the URDF's values), the value for one, the list for one per joint."""
+    """None for [] (the URDF's values), the value for one, the list for one per joint (friction,
+    its turn, armature)."""
     if not values:
         return None
     return float(values[0]) if len(values) == 1 else [float(v) for v in values]
@@ -155,11 +165,23 @@ class UrdfOptions:
         default_factory=list,
         metadata=param(
             "speed over which the Coulomb friction turns, Fc tanh(q'/v_c) (m/s for a prismatic "
-            "joint), one value for every joint or one per joint; [] or 0 = Fc sgn(q'). An "
+            "joint), one value for every joint or one per joint; 0 = Fc sgn(q'); [] = each "
+            "joint's <haptic_dob:dynamics coulomb_speed> from the URDF (0 where none). An "
             "observer's model (haptic-identify --urdf fits it); a simulated arm smooths by its "
             "own physics step and refuses it",
             "rad/s",
             0.0,
             10.0,
+        ),
+    )
+    armature_kg_m2: list[float] | tuple[float, ...] = field(
+        default_factory=list,
+        metadata=param(
+            "rotor inertia reflected to each joint, added to the inertia matrix's diagonal (kg "
+            "for a prismatic joint), one value for every joint or one per joint; [] = each "
+            "joint's <haptic_dob:dynamics armature> from the URDF (0 where none)",
+            "kg m^2",
+            0.0,
+            1e3,
         ),
     )

@@ -1,0 +1,132 @@
+"""A physically consistent set of an arm's parameters that fits its efforts, drawn toward CAD.
+
+Each body's parameters are its joint's child link's (the variables) plus those of the links fixed
+to it (kept as the URDF has them). The child link is parametrised so that every value is
+physically consistent (``Link``): mass ``m = m_0 exp(alpha)`` (> 0), centre of mass ``c = mid +
+half tanh(s)`` (inside the link's box), and the second moment of mass about it ``Sigma = L_0 V V^T
+L_0^T`` with ``V`` lower triangular of diagonal ``exp(d)`` (positive definite: with ``m > 0``,
+the pseudo-inertia ``[[Sigma + m c c^T, m c], [m c^T, m]]`` is positive definite, and the
+rotational inertia ``tr(Sigma) 1 - Sigma`` keeps the triangle inequalities); a log-Cholesky
+parametrisation about the CAD values ``m_0``, ``L_0 L_0^T``. Armature, viscous and Coulomb
+friction are bounded at 0.
+
+``fit_consistent`` minimises ``|R theta - z|^2 / sigma^2`` (the effort's least squares, ``W =
+Q R``, ``z = Q^T tau``) plus the squared distance from CAD: ``alpha``, ``s - s_0``, ``d`` and the
+off-diagonal of ``V``, each dimensionless, and each joint parameter's change in units of its own
+size. Where the record sees a parameter the data outweigh it by the samples' count; where it does
+not, that distance alone decides: the parameter stays at CAD (scipy's ``least_squares``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+Arr = NDArray[np.float64]
+_TRI = ((1, 0), (2, 0), (2, 1))  # V's off-diagonal entries
+_I6 = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))  # pinocchio's order of the inertia
+
+
+@dataclass(frozen=True)
+class Link:
+    """A body's child link: its CAD values, the box its centre of mass stays in (link frame, m)
+    and the other links' fixed parameters (10, in the joint frame)."""
+
+    mass: float  # kg, > 0 (the CAD mass, or a floor where CAD has none)
+    com: Arr  # m, strictly inside the box
+    second_moment: Arr  # kg m^2, (3, 3) positive definite: about the centre of mass
+    lo: Arr
+    hi: Arr
+    rest: Arr
+
+    def values(self, x: Arr) -> tuple[float, Arr, Arr]:
+        """Mass, centre of mass and second moment about it at the variables ``x`` (10,)."""
+        mid, half = 0.5 * (self.lo + self.hi), 0.5 * (self.hi - self.lo)
+        m = self.mass * float(np.exp(x[0]))
+        c = mid + half * np.tanh(x[1:4])
+        V = np.diag(np.exp(x[4:7]))
+        for k, (i, j) in enumerate(_TRI):
+            V[i, j] = x[7 + k]
+        L = np.linalg.cholesky(self.second_moment) @ V
+        return m, c, L @ L.T
+
+    def start(self) -> Arr:
+        """The variables of the CAD values."""
+        mid, half = 0.5 * (self.lo + self.hi), 0.5 * (self.hi - self.lo)
+        out = np.zeros(10)
+        out[1:4] = np.arctanh((self.com - mid) / half)
+        return out
+
+
+def inertia_about_com(second_moment: Arr) -> Arr:
+    """The rotational inertia of a second moment of mass (both about the same point)."""
+    out: Arr = np.trace(second_moment) * np.eye(3) - second_moment
+    return out
+
+
+def body_parameters(m: float, c: Arr, second_moment: Arr) -> Arr:
+    """The ten parameters (pinocchio's order) of a mass ``m`` at ``c`` with that second moment."""
+    inertia = inertia_about_com(second_moment) + m * (float(c @ c) * np.eye(3) - np.outer(c, c))
+    return np.array([m, *(m * c), *(inertia[i, j] for i, j in _I6)])
+
+
+def pseudo_inertia(m: float, c: Arr, second_moment: Arr) -> Arr:
+    """The 4x4 pseudo-inertia ``[[Sigma + m c c^T, m c], [m c^T, m]]`` about the link origin."""
+    out = np.zeros((4, 4))
+    out[:3, :3] = second_moment + m * np.outer(c, c)
+    out[:3, 3] = out[3, :3] = m * c
+    out[3, 3] = m
+    return out
+
+
+@dataclass(frozen=True)
+class ConsistentFit:
+    """Each child link's mass, centre of mass and second moment; armature, viscous and Coulomb
+    friction per joint; the optimiser's word."""
+
+    links: list[tuple[float, Arr, Arr]]
+    armature: Arr
+    viscous: Arr
+    coulomb: Arr
+    theta: Arr  # the standard parameters (bodies', then per joint)
+    message: str
+
+
+def _theta(links: Sequence[Link], x: Arr, dof: int) -> Arr:
+    rigid = [
+        link.rest + body_parameters(*link.values(x[10 * i : 10 * i + 10]))
+        for i, link in enumerate(links)
+    ]
+    return np.concatenate([*rigid, x[10 * len(links) : 10 * len(links) + 3 * dof]])
+
+
+def fit_consistent(
+    R: Arr, z: Arr, sigma: float, links: Sequence[Link], joints: tuple[Arr, Arr, Arr]
+) -> ConsistentFit:
+    """Solve the problem of the module from the CAD values. ``joints`` (each 3 * dof: armature,
+    viscous, Coulomb per joint): the CAD values, the sizes their changes are counted in, and
+    where to start (inside the bounds: a start on a bound holds the solver there)."""
+    joints_cad, joints_scale, joints_start = joints
+    nb, dof = len(links), len(joints_cad) // 3
+    ref = np.concatenate([*(link.start() for link in links), joints_cad])
+    x0 = np.concatenate([ref[: 10 * nb], np.maximum(joints_start, 0.1 * joints_scale)])
+    lower = np.concatenate([np.full(10 * nb, -np.inf), np.zeros(3 * dof)])
+
+    def residual(x: Arr) -> Arr:
+        data = (R @ _theta(links, x, dof) - z) / sigma
+        prior = np.concatenate(
+            [x[: 10 * nb] - ref[: 10 * nb], (x[10 * nb :] - ref[10 * nb :]) / joints_scale]
+        )
+        return np.concatenate([data, prior])
+
+    found = least_squares(residual, x0, bounds=(lower, np.inf), max_nfev=100 * len(x0))
+    x = found.x
+    values = [link.values(x[10 * i : 10 * i + 10]) for i, link in enumerate(links)]
+    j = x[10 * nb :]
+    return ConsistentFit(
+        values, j[:dof], j[dof : 2 * dof], j[2 * dof :], _theta(links, x, dof), str(found.message)
+    )

@@ -1,0 +1,163 @@
+"""A simulated arm whose model is identified, and what its observer makes of a model.
+
+``ArmBench`` is the arm: its hidden truth (a ``UrdfModel``, ``haptic_sim.arm.truth``), the
+device's settings, and the joint impedance (``haptic_dob.teleop.slave``, on the controller's own
+model, the CAD one) that moves it. Each run starts the arm at rest at its start posture; the
+observer (the bench's settings, on the model under test) runs alongside and changes nothing:
+
+- ``play``: the impedance plays an excitation; the record an identification reads;
+- ``free_motion``: the tool sweeps a box of the workspace (16 x 30 x 12 cm, the Lissajous
+  figure of ``haptic_sim.teleop.slave_motion``, 4 s), nothing in contact; the estimate's size
+  after the first 0.5 s (N);
+- ``held_force``: the arm holds its posture and a steady force pushes the tool (from 1 s on);
+  the estimate's mean over the last second against it;
+- ``bias_at_rest``: the arm held still in ``poses`` postures drawn around the start (each joint
+  within 0.6 rad of it, inside its limits); the estimate's size at each after 1 s (N).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from haptic_dob.core.cycle import estimate
+from haptic_dob.core.models import UrdfModel
+from haptic_dob.core.observers.factory import ObserverSettings
+from haptic_dob.identification.arm_excitation import FourierExcitation
+from haptic_dob.identification.arm_model import Record
+from haptic_dob.teleop.slave import SlaveController, SlaveImpedance
+from haptic_sim.arm.device import ArmDeviceParams, SimulatedArm
+from haptic_sim.teleop.slave_motion import sweep
+
+Arr = NDArray[np.float64]
+#: the estimate is judged after this many samples (the observer's start, the sweep's ramp)
+SETTLE = 500
+
+
+@dataclass(frozen=True)
+class ArmBench:
+    """The simulated arm (see the module); ``device.initial_position`` is its start."""
+
+    truth: UrdfModel
+    device: ArmDeviceParams
+    substeps: int = 2
+    rate_hz: float = 1000.0
+    impedance: SlaveImpedance = field(default_factory=lambda: SlaveImpedance(bandwidth_hz=20.0))
+    observer: ObserverSettings = field(default_factory=lambda: ObserverSettings(gain=1000.0))
+
+    def arm(self, **device: object) -> SimulatedArm:
+        """A fresh simulated arm (device settings changed as given)."""
+        return SimulatedArm(
+            self.truth, replace(self.device, **device), rate_hz=self.rate_hz, substeps=self.substeps
+        )
+
+
+Law = Callable[[SlaveController, Arr, Arr, float], list[float]]
+
+
+def _run(
+    bench: ArmBench,
+    models: tuple[UrdfModel, UrdfModel | None],
+    seconds: float,
+    law: Law,
+    trajectory: FourierExcitation | None = None,
+    **device: object,
+) -> tuple[Record, Arr]:
+    """The arm under ``law`` for ``seconds`` (``models``: the controller's, the observer's):
+    its record and the observer's estimates (N, 3)."""
+    control, observer = models
+    arm = bench.arm(**device)
+    ctl = SlaveController(control, bench.impedance, arm.dt, trajectory)
+    obs = None if observer is None else bench.observer.build(observer, arm.dt)
+    n = max(1, round(seconds * bench.rate_hz))
+    stamps, q_, u_, f_ = (
+        np.zeros(n, np.int64),
+        np.zeros((n, arm.dof)),
+        np.zeros((n, arm.dof)),
+        np.zeros((n, 3)),
+    )
+    for k in range(n):
+        s = arm.sample()
+        q, qd = np.asarray(s.q), np.asarray(s.qd)
+        stamps[k], q_[k], u_[k] = s.stamp_ns, q, s.effort
+        if obs is not None:
+            f_[k] = estimate(obs, s.q, s.qd, s.effort)
+        arm.apply(law(ctl, q, qd, k * arm.dt))
+    return Record(stamps, q_, u_, tuple(bench.truth.joint_names)), f_
+
+
+def play(
+    bench: ArmBench, control: UrdfModel, excitation: FourierExcitation, seconds: float
+) -> Record:
+    """The record of the arm playing ``excitation`` for ``seconds``."""
+
+    def law(ctl: SlaveController, q: Arr, qd: Arr, t: float) -> list[float]:
+        return ctl.play(q, qd, t)
+
+    return _run(bench, (control, None), seconds, law, excitation)[0]
+
+
+def free_motion(
+    bench: ArmBench, control: UrdfModel, observer: UrdfModel, seconds: float = 4.0
+) -> Arr:
+    """The estimate's size (N) at each sample after ``SETTLE`` while the tool sweeps a box."""
+    start = np.asarray(bench.device.initial_position, dtype=np.float64)
+    path = sweep(tuple(control.forward_kinematics(start)), (0.08, 0.15, 0.06), (5.3, 6.1, 4.7))
+
+    def law(ctl: SlaveController, q: Arr, qd: Arr, t: float) -> list[float]:
+        return ctl.command(q, qd, path(t))
+
+    _, f = _run(bench, (control, observer), seconds, law)
+    out: Arr = np.linalg.norm(f[SETTLE:], axis=1)
+    return out
+
+
+def _hold(ctl: SlaveController, q: Arr, qd: Arr, _t: float) -> list[float]:
+    if ctl.q_d is None:
+        ctl.start(q)
+    return ctl.joint_command(q, qd, ctl.q_0)
+
+
+def held_force(
+    bench: ArmBench,
+    control: UrdfModel,
+    observer: UrdfModel,
+    force_n: Sequence[float] = (0.0, 0.0, -5.0),
+) -> Arr:
+    """The estimate's mean (N, (3,)) over the last second of 3 s, a steady ``force_n`` pushing
+    the held tool from 1 s on."""
+    _, f = _run(
+        bench,
+        (control, observer),
+        3.0,
+        _hold,
+        external_force_n=tuple(force_n),
+        external_force_at_s=1.0,
+    )
+    out: Arr = np.mean(f[-round(bench.rate_hz) :], axis=0)
+    return out
+
+
+def rest_poses(bench: ArmBench, poses: int = 20, seed: int = 0) -> Arr:
+    """``poses`` postures around the start (each joint within 0.6 rad, inside its limits)."""
+    start = np.asarray(bench.device.initial_position, dtype=np.float64)
+    limits = np.array(bench.truth.position_limits)
+    rng = np.random.default_rng(seed)
+    out: Arr = np.clip(
+        start + rng.uniform(-0.6, 0.6, (poses, start.size)),
+        limits[:, 0] + 0.05,
+        limits[:, 1] - 0.05,
+    )
+    return out
+
+
+def bias_at_rest(bench: ArmBench, control: UrdfModel, observer: UrdfModel, poses: Arr) -> Arr:
+    """The estimate's size (N) after 1 s held still at each of ``poses``, nothing in contact."""
+    out = []
+    for pose in poses:
+        _, f = _run(bench, (control, observer), 1.0, _hold, initial_position=tuple(pose))
+        out.append(float(np.linalg.norm(np.mean(f[-100:], axis=0))))
+    return np.array(out)
