@@ -1,9 +1,11 @@
 """Bags of a driver's ``joint_states`` as ``ros2 bag record`` would hold them (rosbags, MCAP and
-sqlite3), from a 1-DOF record."""
+sqlite3), from a 1-DOF record or an arm's."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from rosbags.rosbag2 import StoragePlugin, Writer
@@ -32,6 +34,35 @@ def write_bag(
             msg.position = np.array([q])
             msg.velocity = np.array([0.0])
             msg.effort = np.array([u]) if effort else np.array([], np.float64)
+            writer.write(conn, int(st) + 1, wire.encode(msg))
+    finally:
+        writer.close()
+    return path
+
+
+def write_arm_bag(
+    path: Path,
+    record: Any,
+    effort: bool = True,
+    names: Sequence[str] | None = None,
+    storage: str = "mcap",
+) -> Path:
+    """An arm's record (``stamps_ns``, ``position``, ``effort``, ``names``) as a driver's
+    ``/joint_states`` bag: every joint in one message, no velocity (a driver that sends none),
+    the joints named ``names`` instead when given."""
+    plugin = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}[storage]
+    writer = Writer(path, version=9, storage_plugin=plugin)
+    writer.open()
+    try:
+        conn = writer.add_connection(
+            "/joint_states", "sensor_msgs/msg/JointState", typestore=wire.TYPESTORE
+        )
+        msg = wire.joint_state(list(names or record.names), "base_link")
+        for st, q, u in zip(record.stamps_ns.tolist(), record.position, record.effort, strict=True):
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(st), 10**9)
+            msg.position = np.asarray(q, np.float64)
+            msg.velocity = np.array([], np.float64)
+            msg.effort = np.asarray(u, np.float64) if effort else np.array([], np.float64)
             writer.write(conn, int(st) + 1, wire.encode(msg))
     finally:
         writer.close()

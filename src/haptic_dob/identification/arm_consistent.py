@@ -8,19 +8,21 @@ L_0^T`` with ``V`` lower triangular of diagonal ``exp(d)`` (positive definite: w
 the pseudo-inertia ``[[Sigma + m c c^T, m c], [m c^T, m]]`` is positive definite, and the
 rotational inertia ``tr(Sigma) 1 - Sigma`` keeps the triangle inequalities); a log-Cholesky
 parametrisation about the CAD values ``m_0``, ``L_0 L_0^T``. Armature, viscous and Coulomb
-friction are bounded at 0.
+friction are squares (>= 0).
 
 ``fit_consistent`` minimises ``|R theta - z|^2 / sigma^2`` (the effort's least squares, ``W =
 Q R``, ``z = Q^T tau``) plus the squared distance from CAD: ``alpha``, ``s - s_0``, ``d`` and the
 off-diagonal of ``V``, each dimensionless, and each joint parameter's change in units of its own
 size. Where the record sees a parameter the data outweigh it by the samples' count; where it does
-not, that distance alone decides: the parameter stays at CAD (scipy's ``least_squares``).
+not, that distance alone decides: the parameter stays at CAD (scipy's ``least_squares``,
+Levenberg-Marquardt; the Jacobian of each body's parameters by central differences).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,6 +31,8 @@ from scipy.optimize import least_squares
 Arr = NDArray[np.float64]
 _TRI = ((1, 0), (2, 0), (2, 1))  # V's off-diagonal entries
 _I6 = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))  # pinocchio's order of the inertia
+#: the central differences' step in the (dimensionless) variables
+STEP = 1e-6
 
 
 @dataclass(frozen=True)
@@ -51,8 +55,28 @@ class Link:
         V = np.diag(np.exp(x[4:7]))
         for k, (i, j) in enumerate(_TRI):
             V[i, j] = x[7 + k]
-        L = np.linalg.cholesky(self.second_moment) @ V
+        L = self.cholesky @ V
         return m, c, L @ L.T
+
+    @cached_property
+    def cholesky(self) -> Arr:
+        """``L_0``: the CAD second moment's Cholesky factor."""
+        out: Arr = np.asarray(np.linalg.cholesky(self.second_moment), dtype=np.float64)
+        return out
+
+    def parameters(self, x: Arr) -> Arr:
+        """The body's ten parameters at the variables ``x``."""
+        out: Arr = self.rest + body_parameters(*self.values(x))
+        return out
+
+    def jacobian(self, x: Arr) -> Arr:
+        """The body's ten parameters' derivatives in ``x`` (10 x 10, central differences)."""
+        out = np.empty((10, 10))
+        for k in range(10):
+            step = np.zeros(10)
+            step[k] = STEP
+            out[:, k] = (self.parameters(x + step) - self.parameters(x - step)) / (2.0 * STEP)
+        return out
 
     def start(self) -> Arr:
         """The variables of the CAD values."""
@@ -97,11 +121,16 @@ class ConsistentFit:
 
 
 def _theta(links: Sequence[Link], x: Arr, dof: int) -> Arr:
-    rigid = [
-        link.rest + body_parameters(*link.values(x[10 * i : 10 * i + 10]))
-        for i, link in enumerate(links)
-    ]
+    rigid = [link.parameters(x[10 * i : 10 * i + 10]) for i, link in enumerate(links)]
     return np.concatenate([*rigid, x[10 * len(links) : 10 * len(links) + 3 * dof]])
+
+
+def _theta_jacobian(links: Sequence[Link], x: Arr) -> Arr:
+    """``d theta / d x``: a 10 x 10 block per body, the identity for the joints' parameters."""
+    out = np.eye(x.size)
+    for i, link in enumerate(links):
+        out[10 * i : 10 * i + 10, 10 * i : 10 * i + 10] = link.jacobian(x[10 * i : 10 * i + 10])
+    return out
 
 
 def fit_consistent(
@@ -109,24 +138,36 @@ def fit_consistent(
 ) -> ConsistentFit:
     """Solve the problem of the module from the CAD values. ``joints`` (each 3 * dof: armature,
     viscous, Coulomb per joint): the CAD values, the sizes their changes are counted in, and
-    where to start (inside the bounds: a start on a bound holds the solver there)."""
+    where to start (least squares' values; a start at 0 would hold a square there)."""
     joints_cad, joints_scale, joints_start = joints
     nb, dof = len(links), len(joints_cad) // 3
-    ref = np.concatenate([*(link.start() for link in links), joints_cad])
-    x0 = np.concatenate([ref[: 10 * nb], np.maximum(joints_start, 0.1 * joints_scale)])
-    lower = np.concatenate([np.full(10 * nb, -np.inf), np.zeros(3 * dof)])
+    rigid = 10 * nb
+    ref = np.concatenate([link.start() for link in links])
+    u0 = np.concatenate([ref, np.sqrt(np.maximum(joints_start, 0.1 * joints_scale))])
 
-    def residual(x: Arr) -> Arr:
+    def params(u: Arr) -> Arr:  # the joints' parameters are squares: >= 0
+        return np.concatenate([u[:rigid], u[rigid:] ** 2])
+
+    def residual(u: Arr) -> Arr:
+        x = params(u)
         data = (R @ _theta(links, x, dof) - z) / sigma
-        prior = np.concatenate(
-            [x[: 10 * nb] - ref[: 10 * nb], (x[10 * nb :] - ref[10 * nb :]) / joints_scale]
-        )
+        prior = np.concatenate([x[:rigid] - ref, (x[rigid:] - joints_cad) / joints_scale])
         return np.concatenate([data, prior])
 
-    found = least_squares(residual, x0, bounds=(lower, np.inf), max_nfev=100 * len(x0))
-    x = found.x
+    def jacobian(u: Arr) -> Arr:
+        J = _theta_jacobian(links, params(u))
+        J[:, rigid:] *= 2.0 * u[rigid:]
+        prior = np.zeros((u.size, u.size))
+        prior[:rigid, :rigid] = np.eye(rigid)
+        prior[rigid:, rigid:] = np.diag(2.0 * u[rigid:] / joints_scale)
+        return np.vstack([R @ J / sigma, prior])
+
+    # Levenberg-Marquardt (MINPACK): the bounded methods stalled here (trf took hundreds of
+    # reflective steps, dogbox stuck far off on a published arm)
+    found = least_squares(residual, u0, jac=jacobian, method="lm", max_nfev=100 * len(u0))
+    x = params(found.x)
     values = [link.values(x[10 * i : 10 * i + 10]) for i, link in enumerate(links)]
-    j = x[10 * nb :]
+    j = x[rigid:]
     return ConsistentFit(
         values, j[:dof], j[dof : 2 * dof], j[2 * dof :], _theta(links, x, dof), str(found.message)
     )

@@ -46,8 +46,8 @@ class FourierExcitation:
         q = np.array(self.start) + (s / w) @ a.T + ((1.0 - c) / w) @ b.T
         return q, c @ a.T + s @ b.T, (-s * w) @ a.T + (c * w) @ b.T
 
-    def save(self, path: str | Path) -> None:
-        """Write the trajectory file (YAML)."""
+    def save(self, path: str | Path, note: str = "") -> None:
+        """Write the trajectory file (YAML), ``note`` as a comment at its top."""
         doc = {
             "kind": "fourier",
             "joints": list(self.joints),
@@ -57,6 +57,7 @@ class FourierExcitation:
             "cosine": [list(r) for r in self.cosine],
         }
         head = "# an arm's excitation (haptic_dob.identification.arm_excitation)\n"
+        head += "".join(f"# {line}\n" for line in note.splitlines())
         Path(path).write_text(head + yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
 
     @classmethod

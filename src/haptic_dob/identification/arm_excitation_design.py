@@ -122,7 +122,7 @@ class _Problem:
             parts += [(tips - self.box[0]).ravel(), (self.box[1] - tips).ravel()]
         nl = np.concatenate(parts)
         out = (
-            math.log(ap.gram_condition_number(W[:, self.base])),
+            math.log(ap.condition_number(W[:, self.base])),
             np.where(np.isfinite(nl), nl, 1e9),
         )
         if s is None:
@@ -243,6 +243,10 @@ def _design(
         peak_speed_share=float(np.max(np.abs(v) / p.vmax)),
         peak_accel_share=float(np.max(np.abs(a)) / p.limits.max_accel_rad_s2),
         peak_effort_share=float(np.max(np.abs(tau) / (p.emax / p.limits.effort_share))),
-        tip_lo=tuple(float(c) for c in tips.min(axis=0)),  # type: ignore[arg-type]
-        tip_hi=tuple(float(c) for c in tips.max(axis=0)),  # type: ignore[arg-type]
+        tip_lo=_triple(tips.min(axis=0)),
+        tip_hi=_triple(tips.max(axis=0)),
     )
+
+
+def _triple(v: Arr) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))

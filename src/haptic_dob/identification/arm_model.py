@@ -39,8 +39,9 @@ from haptic_dob.identification.arm_consistent import (
 )
 from haptic_dob.identification.arm_friction import coulomb_term, turn_filters, turn_speed
 from haptic_dob.identification.arm_model_report import ArmModelFit, JointFit, LinkFit
+from haptic_dob.identification.arm_normal import Normal, condition_number, solve, square_root
 from haptic_dob.identification.arm_urdf import LinkInertial, link_inertials
-from haptic_dob.identification.filters import IdentificationError, MotionFilters, fit
+from haptic_dob.identification.filters import IdentificationError, MotionFilters
 
 Arr = NDArray[np.float64]
 #: a base parameter the record determines with more than 1 / this the variance per sample that
@@ -98,10 +99,14 @@ def identify_arm_model(
         raise IdentificationError(f"too short: {len(idx)} samples to fit, {len(held)} held out")
     sign = f.coulomb_term(v_light)
     W = ap.regressor(cad, x[idx], v[idx], a[idx], sign[idx])
+    y = tau[idx].ravel()
     W_ref = ap.regressor(cad, *ap.reference_states(cad, ap.REFERENCE_STATES))
     bs = ap.base_set(W_ref)
     names = bs.names(lay)
-    seen = ap.visibility(W[:, bs.base], W_ref[:, bs.base], dof)
+    normal = Normal.of(W, y, dof)
+    G, b, yy = normal.total()
+    G_ref = W_ref.T @ W_ref / ap.REFERENCE_STATES
+    seen = ap.visibility(G[np.ix_(bs.base, bs.base)] / len(idx), G_ref[np.ix_(bs.base, bs.base)])
     unseen = ap.unseen_names(names, seen, min_visibility)
     if unseen:
         more = f" and {len(unseen) - 8} more" if len(unseen) > 8 else ""
@@ -110,18 +115,17 @@ def identify_arm_model(
             f"motion determines each less than {min_visibility:g} as well as motion across the "
             "joints' ranges would); record a richer excitation (haptic-excite)"
         )
-    y = tau[idx].ravel()
-    beta, _, _ = fit(W[:, bs.base], y, "the arm")
+    beta, _, _ = solve(G, b, yy, len(y), bs.base, "the arm")
     speeds = _turn_speeds(
         cad, (f, wide), (position, record.effort, v_light), (W, y, idx, split), bs, beta, lay
     )
     coulomb = np.column_stack([coulomb_term(f, v_light[:, j], c) for j, c in enumerate(speeds)])
     W = ap.with_coulomb(W, coulomb[idx])
-    beta, _, _ = fit(W[:, bs.base], y, "the arm")
-    r = (y - W[:, bs.base] @ beta).reshape(len(idx), dof)
-    weight = np.tile(1.0 / np.maximum(np.sqrt(np.mean(r * r, axis=0)), 1e-12), len(idx))
-    Ww, yw = W * weight[:, None], y * weight  # each joint's rows by its own residual
-    beta, std, sigma = fit(Ww[:, bs.base], yw, "the arm")
+    normal = Normal.of(W, y, dof)
+    beta, _, _ = solve(*normal.total(), len(y), bs.base, "the arm")
+    weight = 1.0 / np.maximum(normal.residual_rms(bs.base, beta), 1e-12)  # each joint's rows
+    Gw, bw, yyw = normal.total(weight)
+    beta, std, sigma = solve(Gw, bw, yyw, len(y), bs.base, "the arm")
     inertials = link_inertials(urdf)
     links = [_link(b, inertials, margin_m) for b in bodies(cad)]
     cad_joint = np.concatenate([cad.armature, cad.viscous, cad.coulomb])
@@ -129,8 +133,8 @@ def identify_arm_model(
     start = cad_joint.copy()
     at = bs.base >= lay.rigid
     start[bs.base[at] - lay.rigid] = beta[at]  # least squares' friction and armature
-    Q, R = np.linalg.qr(Ww)
-    found = fit_consistent(R, Q.T @ yw, sigma, links, (cad_joint, scale, start))
+    R, z = square_root(Gw, bw)
+    found = fit_consistent(R, z, sigma, links, (cad_joint, scale, start))
     _check(lay.links, links, found)
     W_held = ap.regressor(cad, x[held], v[held], a[held], coulomb[held])
     cad_theta = np.concatenate([body_parameters(cad).ravel(), cad_joint])
@@ -144,7 +148,7 @@ def identify_arm_model(
         joints=_joint_fits(lay.joints, found, speeds, heldout),
         holdout=holdout,
         samples=len(idx),
-        condition_number=ap.condition_number(W[:, bs.base]),
+        condition_number=condition_number(normal.total()[0], bs.base),
         visibility=tuple((nm, float(v_)) for nm, v_ in zip(names, seen, strict=True)),
         unidentifiable=tuple(lay.names[i] for i in bs.dependent),
     )
@@ -166,10 +170,12 @@ def _turn_speeds(
     position, effort, v_light = raw
     W, y, idx, split = fitted
     n, dof = position.shape
-    rigid = np.where(bs.base < lay.rigid + dof, beta, 0.0)  # no friction
+    rigid = np.zeros(lay.size)  # the fitted rigid body and armature, no friction
+    keep = bs.base < lay.rigid + dof
+    rigid[bs.base[keep]] = beta[keep]
     _, v, _ = f.motion(position)
     r = np.zeros((n, dof))
-    r[idx] = (y - W[:, bs.base] @ rigid).reshape(len(idx), dof)
+    r[idx] = (y - W @ rigid).reshape(len(idx), dof)
     if wide is f:
         v_w, r_w, idx_w = v, r, idx
     else:
@@ -177,7 +183,7 @@ def _turn_speeds(
         idx_w = np.arange(2 * wide.window, split, wide.step)
         W_w = ap.regressor(cad, x_w[idx_w], v_w[idx_w], a_w[idx_w], np.zeros((len(idx_w), dof)))
         r_w = np.zeros((n, dof))
-        r_w[idx_w] = wide.effort(effort)[idx_w] - (W_w[:, bs.base] @ rigid).reshape(-1, dof)
+        r_w[idx_w] = wide.effort(effort)[idx_w] - (W_w @ rigid).reshape(-1, dof)
     return [
         turn_speed(
             f, wide, v_light[:, j], (v[:, j], r[:, j], idx), (v_w[:, j], r_w[:, j], idx_w), name
@@ -221,7 +227,8 @@ def _joint_scales(
     for k, column in enumerate(bs.base):
         if column >= lay.rigid:
             out[column - lay.rigid] = abs(beta[k]) + 3.0 * std[k]
-    return np.maximum(out, 1e-9)
+    scale: Arr = np.maximum(out, 1e-9)
+    return scale
 
 
 def _check(names: Sequence[str], links: Sequence[Link], found: ConsistentFit) -> None:
@@ -239,13 +246,13 @@ def _check(names: Sequence[str], links: Sequence[Link], found: ConsistentFit) ->
 def _link_fit(name: str, link: Link, found: tuple[float, Arr, Arr]) -> LinkFit:
     m, c, sigma = found
     inertia = inertia_about_com(sigma)
+    xx, xy, xz = (float(v) for v in inertia[0])
+    yy, yz, zz = float(inertia[1, 1]), float(inertia[1, 2]), float(inertia[2, 2])
     return LinkFit(
         link=name,
         mass=float(m),
         com=_triple(c),
-        inertia=tuple(
-            float(inertia[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
-        ),  # type: ignore[arg-type]
+        inertia=(xx, xy, xz, yy, yz, zz),
         cad_mass=link.mass,
         cad_com=_triple(link.com),
         box_lo=_triple(link.lo),

@@ -131,7 +131,7 @@ def base_set(W: Arr) -> BaseSet:
             base.append(i)
             basis = np.column_stack([basis, r / np.linalg.norm(r)])
     b, d = np.array(base, dtype=np.intp), np.array(dependent, dtype=np.intp)
-    K, *_ = np.linalg.lstsq(W[:, b], W[:, d], rcond=None)
+    K = np.asarray(np.linalg.lstsq(W[:, b], W[:, d], rcond=None)[0], dtype=np.float64)
     K[np.abs(K) < 1e-9 * max(1.0, float(np.max(np.abs(K), initial=0.0)))] = 0.0
     return BaseSet(b, d, K)
 
@@ -144,29 +144,20 @@ def _variances(A: Arr) -> Arr:
     return out
 
 
-def visibility(W_data: Arr, W_reference: Arr, dof: int) -> Arr:
+def visibility(per_data: Arr, per_reference: Arr) -> Arr:
     """Per column (base parameters), the variance of its estimate per sample from motion across
-    the joints (``W_reference``) over that from the record (``W_data``): 1 sees it as well, 0
-    not at all. Both regressors are sample by sample, ``dof`` rows each."""
-    scale = np.linalg.norm(W_reference, axis=0)
+    the joints over that from the record: 1 sees it as well, 0 not at all. Each argument is a
+    regressor's Gram matrix per sample, ``W^T W / N`` (N samples of dof rows)."""
+    scale = np.sqrt(np.diag(per_reference))
     scale[scale == 0.0] = 1.0
-    Wd, Wr = W_data / scale, W_reference / scale
-    per_data = _variances(Wd.T @ Wd / (Wd.shape[0] / dof))
-    per_ref = _variances(Wr.T @ Wr / (Wr.shape[0] / dof))
-    out: Arr = per_ref / per_data
+    outer = np.outer(scale, scale)
+    out: Arr = _variances(per_reference / outer) / _variances(per_data / outer)
     return out
 
 
 def condition_number(W: Arr) -> float:
-    """The condition number of ``W`` with its columns scaled to unit norm."""
-    norms = np.linalg.norm(W, axis=0)
-    s = np.linalg.svd(W / np.where(norms > 0.0, norms, 1.0), compute_uv=False)
-    return float(s[0] / s[-1]) if s[-1] > 0.0 else float("inf")
-
-
-def gram_condition_number(W: Arr) -> float:
-    """``condition_number`` from the eigenvalues of the scaled Gram matrix (cheaper; exact to
-    about 1e-8 / cond)."""
+    """The condition number of ``W`` with its columns scaled to unit norm (from the eigenvalues
+    of its Gram matrix: exact to about 1e-8 times it)."""
     norms = np.linalg.norm(W, axis=0)
     Ws = W / np.where(norms > 0.0, norms, 1.0)
     w = np.linalg.eigvalsh(Ws.T @ Ws)

@@ -5,7 +5,8 @@ inertia about it (kg m^2), both in the link frame's axes (the ``<origin rpy>`` a
 ``rewrite_urdf`` returns the XML with the given links' ``<inertial>`` replaced (origin at the
 centre of mass, ``rpy`` zero) and the given joints' ``<dynamics damping friction>`` set, their
 armature and Coulomb turn in ``<haptic_dob:dynamics>`` (``haptic_dob.core.models.urdf``); every
-other element, attribute and comment is kept, and a comment says where the values came from.
+other element, attribute and comment is kept (the XML's layout is not), and a comment says where
+the values came from.
 """
 
 from __future__ import annotations
@@ -80,7 +81,7 @@ def link_inertials(urdf: str) -> dict[str, LinkInertial]:
     """Every link's inertial (zero for a link without one); ``urdf`` is XML text or a path."""
     root = ET.fromstring(read_urdf(urdf))
     out = {}
-    for link in root.iter("link"):
+    for link in root.findall("link"):
         name = link.get("name", "")
         inertial = link.find("inertial")
         if inertial is None:
@@ -150,8 +151,8 @@ def rewrite_urdf(
             ET.register_namespace(prefix, uri)
     ET.register_namespace("haptic_dob", URDF_NAMESPACE)
     root = ET.fromstring(xml, parser=ET.XMLParser(target=ET.TreeBuilder(insert_comments=True)))
-    links = {el.get("name", ""): el for el in root.iter("link")}
-    joints = {el.get("name", ""): el for el in root.iter("joint")}
+    links = {el.get("name", ""): el for el in root.findall("link")}
+    joints = {el.get("name", ""): el for el in root.findall("joint")}
     for name, inertial in inertials.items():
         if name not in links:
             raise ValueError(f"urdf: no link {name!r}")
@@ -162,4 +163,6 @@ def rewrite_urdf(
         _set_dynamics(joints[name], dyn)
     root.insert(0, ET.Comment(f" {note.replace('--', '- -')} "))
     ET.indent(root, space="  ")
-    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+    prolog = re.sub(r"<\?xml[^>]*\?>", "", xml[: xml.find("<robot")]).strip()  # its comments
+    head = '<?xml version="1.0"?>\n' + (prolog + "\n" if prolog else "")
+    return head + ET.tostring(root, encoding="unicode") + "\n"

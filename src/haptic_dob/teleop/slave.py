@@ -20,9 +20,12 @@ are diagonal.
 the wall while the arm stops at it; the joints' springs push with the difference.
 
 With ``trajectory_path`` (an excitation file, ``haptic_dob.identification.arm_excitation``) the
-slave plays it instead (``play``): ``tau = K (q_d(t) - q) + B (q_d'(t) - q') + G(q)``, t from the
-first sample, the difference between the arm's first posture and the trajectory's start fading
-out over ``BLEND_S`` (a cosine); no point is tracked.
+slave plays it instead (``play``), by computed torque on its model: ``tau = D(q) (q_d'' + w^2
+(q_d - q) + 2 zeta w (q_d' - q')) + C(q, q') q' + G(q)`` (friction too, where the model has it),
+t from the first sample, the difference between the arm's first posture and the trajectory's
+start fading out over ``BLEND_S`` (a cosine); no point is tracked. The inertia is the posture's:
+gains fixed at the start posture would leave modes far lighter elsewhere (joints whose axes line
+up) ringing at 500 Hz against the effort limits, as an excitation across the workspace meets.
 """
 
 from __future__ import annotations
@@ -189,13 +192,20 @@ class SlaveController:
             raise ValueError("no trajectory to play (slave.trajectory_path is '')")
         if self.q_d is None:
             self.start(q)
-        (q_d,), (v_d,), _ = traj.motion(np.array([t_s]))
+        (q_d,), (v_d,), (a_d,) = traj.motion(np.array([t_s]))
         if t_s < BLEND_S:
             gap = self.q_0 - np.asarray(traj.start)
             phase = math.pi * t_s / BLEND_S
+            w = math.pi / BLEND_S
             q_d = q_d + (0.5 + 0.5 * math.cos(phase)) * gap
-            v_d = v_d - 0.5 * math.pi / BLEND_S * math.sin(phase) * gap
-        return self.joint_command(q, qd, q_d, v_d)
+            v_d = v_d - 0.5 * w * math.sin(phase) * gap
+            a_d = a_d - 0.5 * w * w * math.cos(phase) * gap
+        s = self.settings
+        w = 2.0 * math.pi * s.bandwidth_hz
+        D, h = self.model._mass_matrix(q), self.model._bias_effort(q, qd)
+        tau = D @ (a_d + w * w * (q_d - q) + 2.0 * s.damping_ratio * w * (v_d - qd)) + h
+        out: list[float] = tau.tolist()
+        return out if self.limits is None else saturate(out, self.limits)
 
     def joint_command(self, q: Vec, qd: Vec, q_d: Vec, qd_d: Vec | None = None) -> list[float]:
         """``K (q_d - q) + B (q_d' - q') + G(q)``, saturated (N m or N): the impedance around

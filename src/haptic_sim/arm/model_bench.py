@@ -48,10 +48,10 @@ class ArmBench:
     impedance: SlaveImpedance = field(default_factory=lambda: SlaveImpedance(bandwidth_hz=20.0))
     observer: ObserverSettings = field(default_factory=lambda: ObserverSettings(gain=1000.0))
 
-    def arm(self, **device: object) -> SimulatedArm:
-        """A fresh simulated arm (device settings changed as given)."""
+    def arm(self, device: ArmDeviceParams | None = None) -> SimulatedArm:
+        """A fresh simulated arm (with other device settings, if given)."""
         return SimulatedArm(
-            self.truth, replace(self.device, **device), rate_hz=self.rate_hz, substeps=self.substeps
+            self.truth, device or self.device, rate_hz=self.rate_hz, substeps=self.substeps
         )
 
 
@@ -64,12 +64,12 @@ def _run(
     seconds: float,
     law: Law,
     trajectory: FourierExcitation | None = None,
-    **device: object,
+    device: ArmDeviceParams | None = None,
 ) -> tuple[Record, Arr]:
     """The arm under ``law`` for ``seconds`` (``models``: the controller's, the observer's):
     its record and the observer's estimates (N, 3)."""
     control, observer = models
-    arm = bench.arm(**device)
+    arm = bench.arm(device)
     ctl = SlaveController(control, bench.impedance, arm.dt, trajectory)
     obs = None if observer is None else bench.observer.build(observer, arm.dt)
     n = max(1, round(seconds * bench.rate_hz))
@@ -134,8 +134,11 @@ def held_force(
         (control, observer),
         3.0,
         _hold,
-        external_force_n=tuple(force_n),
-        external_force_at_s=1.0,
+        device=replace(
+            bench.device,
+            external_force_n=(float(force_n[0]), float(force_n[1]), float(force_n[2])),
+            external_force_at_s=1.0,
+        ),
     )
     out: Arr = np.mean(f[-round(bench.rate_hz) :], axis=0)
     return out
@@ -158,6 +161,12 @@ def bias_at_rest(bench: ArmBench, control: UrdfModel, observer: UrdfModel, poses
     """The estimate's size (N) after 1 s held still at each of ``poses``, nothing in contact."""
     out = []
     for pose in poses:
-        _, f = _run(bench, (control, observer), 1.0, _hold, initial_position=tuple(pose))
+        _, f = _run(
+            bench,
+            (control, observer),
+            1.0,
+            _hold,
+            device=replace(bench.device, initial_position=tuple(pose.tolist())),
+        )
         out.append(float(np.linalg.norm(np.mean(f[-100:], axis=0))))
     return np.array(out)

@@ -197,7 +197,7 @@ def extra_dynamics(xml: str) -> dict[str, dict[str, float]]:
     if URDF_NAMESPACE not in xml:
         return {}
     out: dict[str, dict[str, float]] = {}
-    for joint in ET.fromstring(xml).iter("joint"):
+    for joint in ET.fromstring(xml).findall("joint"):
         element = joint.find(EXTRA_DYNAMICS)
         if element is None:
             continue
