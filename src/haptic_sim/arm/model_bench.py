@@ -5,7 +5,9 @@ device's settings, and the joint impedance (``haptic_dob.teleop.slave``, on the 
 model, the CAD one) that moves it. Each run starts the arm at rest at its start posture; the
 observer (the bench's settings, on the model under test) runs alongside and changes nothing:
 
-- ``play``: the impedance plays an excitation; the record an identification reads;
+- ``play``: the controller plays an excitation (computed torque); the record an identification
+  reads, to the bit a lockstep graph's bag of the same (the device node, the slave controller
+  node with ``slave.trajectory_path``, a session of ``seconds``: samples 0 to ``seconds``);
 - ``free_motion``: the tool sweeps a box of the workspace (16 x 30 x 12 cm, the Lissajous
   figure of ``haptic_sim.teleop.slave_motion``, 4 s), nothing in contact; the estimate's size
   after the first 0.5 s (N);
@@ -72,7 +74,7 @@ def _run(
     arm = bench.arm(device)
     ctl = SlaveController(control, bench.impedance, arm.dt, trajectory)
     obs = None if observer is None else bench.observer.build(observer, arm.dt)
-    n = max(1, round(seconds * bench.rate_hz))
+    n = round(seconds * bench.rate_hz) + 1  # samples 0 to ``seconds``, as a device node's session
     stamps, q_, u_, f_ = (
         np.zeros(n, np.int64),
         np.zeros((n, arm.dof)),
@@ -85,7 +87,7 @@ def _run(
         stamps[k], q_[k], u_[k] = s.stamp_ns, q, s.effort
         if obs is not None:
             f_[k] = estimate(obs, s.q, s.qd, s.effort)
-        arm.apply(law(ctl, q, qd, k * arm.dt))
+        arm.apply(law(ctl, q, qd, s.stamp_ns * 1e-9))  # as the node times it: bit for bit
     return Record(stamps, q_, u_, tuple(bench.truth.joint_names)), f_
 
 
