@@ -33,11 +33,13 @@ from haptic_sim.arm.model_bench import (
     rest_poses,
 )
 from haptic_sim.teleop.config import TeleopConfig
-from haptic_sim.teleop.slave_motion import SLAVE_TURN_CUTOFF_HZ
 
 Arr = NDArray[np.float64]
 #: the slave's excitation (``haptic-excite``), beside ``config/urdf``
 EXCITATION = "excitation/arm7_slave.yaml"
+#: the low-pass (Hz) through which the slave's Coulomb turns are searched: its encoders resolve
+#: 1 urad a sample, speeds far below the 1 mrad/s its heaviest joint's friction turns over
+SLAVE_TURN_CUTOFF_HZ = 50.0
 #: the steady force the held tool is pushed with (N, base frame: down)
 HELD_FORCE_N = (0.0, 0.0, -5.0)
 #: postures the bias at rest is measured in
