@@ -1,21 +1,16 @@
 """A physically consistent set of an arm's parameters that fits its efforts, drawn toward CAD.
 
-Each body's parameters are its joint's child link's (the variables) plus those of the links fixed
-to it (kept as the URDF has them). The child link is parametrised so that every value is
-physically consistent (``Link``): mass ``m = m_0 exp(alpha)`` (> 0), centre of mass ``c = mid +
-half tanh(s)`` (inside the link's box), and the second moment of mass about it ``Sigma = L_0 V V^T
-L_0^T`` with ``V`` lower triangular of diagonal ``exp(d)`` (positive definite: with ``m > 0``,
-the pseudo-inertia ``[[Sigma + m c c^T, m c], [m c^T, m]]`` is positive definite, and the
-rotational inertia ``tr(Sigma) 1 - Sigma`` keeps the triangle inequalities); a log-Cholesky
-parametrisation about the CAD values ``m_0``, ``L_0 L_0^T``. Armature, viscous and Coulomb
-friction are squares (>= 0).
+A body's parameters are its joint's child link's (the variables) plus the fixed links' (the
+URDF's). The child link (``Link``): mass ``m_0 exp(alpha)``, centre of mass ``mid + half
+tanh(s)`` (in its box), second moment about it ``L_0 V V^T L_0^T``, ``V`` lower triangular with
+diagonal ``exp(d)`` (with m > 0 the pseudo-inertia is positive definite, the inertia keeps the
+triangle inequalities): log-Cholesky about the CAD ``m_0``, ``L_0 L_0^T``. Armature and friction
+are squares (>= 0).
 
-``fit_consistent`` minimises ``|R theta - z|^2 / sigma^2`` (the effort's least squares, ``W =
-Q R``, ``z = Q^T tau``) plus the squared distance from CAD: ``alpha``, ``s - s_0``, ``d`` and the
-off-diagonal of ``V``, each dimensionless, and each joint parameter's change in units of its own
-size. Where the record sees a parameter the data outweigh it by the samples' count; where it does
-not, that distance alone decides: the parameter stays at CAD (scipy's ``least_squares``,
-Levenberg-Marquardt; the Jacobian of each body's parameters by central differences).
+``fit_consistent`` minimises ``|R theta - z|^2 / sigma^2`` (the effort's least squares) plus the
+squared distance from CAD (``alpha``, ``s - s_0``, ``d``, V's off-diagonal; joint parameters in
+units of their size): the data outweigh it where they see a parameter, it decides where they do
+not. scipy's Levenberg-Marquardt; each body's Jacobian by central differences.
 """
 
 from __future__ import annotations

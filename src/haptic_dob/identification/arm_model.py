@@ -1,21 +1,14 @@
 """An arm's model from its joint states: rigid body, armature and joint friction beyond CAD.
 
-ROS-free. The URDF gives the kinematics and the CAD values; the record gives joint positions and
-the efforts applied (velocities are not needed: positions are differentiated through the filters
-of ``haptic_dob.identification.filters``, the joint friction's). Each joint's effort is
-``W theta`` (``arm_parameters``), with the Coulomb term ``tanh(q' / v_c)``:
-
+ROS-free. The URDF gives the kinematics and CAD values, the record joint positions and applied
+efforts (positions differentiated through ``filters``). Effort = ``W theta`` (``arm_parameters``):
 1. the regressor on the first ``1 - holdout`` of the record (filters' ends out, decimated);
-2. the record's visibility of each base parameter: one below ``min_visibility`` is refused,
-   naming them (too little excitation: they would be fitted to noise);
-3. the base parameters by least squares (Coulomb friction a filtered sign), each joint's ``v_c``
-   on what the rigid body leaves (``arm_friction.turn_speed``), least squares again, then
-   weighted: each joint's rows by the inverse of its residual's RMS (a light wrist's effort is
-   then not drowned by the shoulder's);
-4. a physically consistent full set (``arm_consistent``), drawn toward CAD where the record does
-   not see a parameter, and checked: positive mass, centre of mass in the link's box (the
-   origins its link carries and the CAD inertia's equivalent box, plus ``margin_m``),
-   pseudo-inertia positive definite;
+2. each base parameter's visibility: one below ``min_visibility`` is refused, named;
+3. least squares (Coulomb a filtered sign), each joint's ``v_c`` (``arm_friction.turn_speed``),
+   least squares again, then weighted by each joint's residual RMS (``arm_normal``);
+4. a physically consistent full set (``arm_consistent``) drawn toward CAD, checked: mass > 0,
+   centre of mass in the link's box (the origins its link carries and the CAD inertia's
+   equivalent box, plus ``margin_m``), pseudo-inertia positive definite;
 5. each joint's held-out RMS residual against its torque span, identified and CAD.
 """
 

@@ -19,13 +19,9 @@ are diagonal.
 ``q_d`` and ``q_0`` start at the first sample's joint positions. In contact the target runs into
 the wall while the arm stops at it; the joints' springs push with the difference.
 
-With ``trajectory_path`` (an excitation file, ``haptic_dob.identification.arm_excitation``) the
-slave plays it instead (``play``), by computed torque on its model: ``tau = D(q) (q_d'' + w^2
-(q_d - q) + 2 zeta w (q_d' - q')) + C(q, q') q' + G(q)`` (friction too, where the model has it),
-t from the first sample, the difference between the arm's first posture and the trajectory's
-start fading out over ``BLEND_S`` (a cosine); no point is tracked. The inertia is the posture's:
-gains fixed at the start posture would leave modes far lighter elsewhere (joints whose axes line
-up) ringing at 500 Hz against the effort limits, as an excitation across the workspace meets.
+With ``trajectory_path`` (an excitation file) it plays that instead (``play``): computed torque
+``D(q) (q_d'' + w^2 e + 2 zeta w e') + C q' + G`` (friction too, where the model has it), t
+from the first sample, the first posture's offset fading over ``BLEND_S``; no point is tracked.
 """
 
 from __future__ import annotations

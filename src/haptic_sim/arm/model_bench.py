@@ -1,20 +1,15 @@
 """A simulated arm whose model is identified, and what its observer makes of a model.
 
-``ArmBench`` is the arm: its hidden truth (a ``UrdfModel``, ``haptic_sim.arm.truth``), the
-device's settings, and the joint impedance (``haptic_dob.teleop.slave``, on the controller's own
-model, the CAD one) that moves it. Each run starts the arm at rest at its start posture; the
-observer (the bench's settings, on the model under test) runs alongside and changes nothing:
-
-- ``play``: the controller plays an excitation (computed torque); the record an identification
-  reads, to the bit a lockstep graph's bag of the same (the device node, the slave controller
-  node with ``slave.trajectory_path``, a session of ``seconds``: samples 0 to ``seconds``);
-- ``free_motion``: the tool sweeps a box of the workspace (16 x 30 x 12 cm, the Lissajous
-  figure of ``haptic_sim.teleop.slave_motion``, 4 s), nothing in contact; the estimate's size
-  after the first 0.5 s (N);
-- ``held_force``: the arm holds its posture and a steady force pushes the tool (from 1 s on);
-  the estimate's mean over the last second against it;
-- ``bias_at_rest``: the arm held still in ``poses`` postures drawn around the start (each joint
-  within 0.6 rad of it, inside its limits); the estimate's size at each after 1 s (N).
+``ArmBench``: the arm's hidden truth (``haptic_sim.arm.truth``), device settings, and the joint
+impedance (``haptic_dob.teleop.slave``, on the controller's CAD model) that moves it from rest at
+its start; the observer (on the model under test) runs alongside and changes nothing.
+- ``play``: the controller plays an excitation; the record, to the bit a lockstep graph's bag of
+  it (samples 0 to ``seconds``, timed by stamp as the slave controller node does);
+- ``free_motion``: the tool sweeping a 16 x 30 x 12 cm box for 4 s; the estimate's size (N)
+  after the first 0.5 s;
+- ``held_force``: a steady force on the held tool from 1 s on; the estimate's mean, last second;
+- ``bias_at_rest``: held still in postures drawn within 0.6 rad of the start (inside the limits);
+  the estimate's size after 1 s (N).
 """
 
 from __future__ import annotations

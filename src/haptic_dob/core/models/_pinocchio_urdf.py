@@ -13,10 +13,8 @@ What a real arm's description holds and how it is used:
 - meshes (``package://``, relative paths): never read (dynamics need none);
 - floating, planar and other multi-DOF joints: refused with the joint's name when they would be
   a coordinate (leave them out of ``joint_names`` to lock them);
-- ``<dynamics damping friction>``: viscous and Coulomb joint friction; what URDF has no word
-  for, a joint's armature (rotor inertia) and the speed its Coulomb friction turns over, in the
-  element ``<haptic_dob:dynamics armature=".." coulomb_speed=".."/>`` of the joint (namespace
-  ``URDF_NAMESPACE``, declared on ``<robot>``; other URDF readers skip it).
+- ``<dynamics damping friction>``: joint friction; a joint's armature and Coulomb turn in its
+  ``<haptic_dob:dynamics armature=".." coulomb_speed=".."/>`` (``URDF_NAMESPACE``).
 
 Every joint that is not chosen is locked at its neutral position (zero angle or offset).
 """
