@@ -234,10 +234,10 @@ def slave_tables(r: SlaveModelResult) -> str:
         )
     lines += [
         "",
-        f"**The identification** ({r.seconds:g} s, {r.samples} samples fitted, condition number "
+        f"**The identification** ({r.seconds:.0f} s, {r.samples} samples fitted, condition number "
         f"{r.condition_number:.3g}; held-out residual, % of each joint's torque span):",
         "",
-        "| joint | residual: CAD -> identified | armature (kg m^2): identified / truth | viscous "
+        "| joint | residual: CAD -> identified | identified / truth: armature (kg m^2) | viscous "
         "(N m s/rad) | Coulomb (N m) |",
         "|---|---|---|---|---|",
     ]
@@ -253,9 +253,10 @@ def slave_tables(r: SlaveModelResult) -> str:
         + ", ".join(
             f"{n} {c:.2f} -> {m:.2f}" for n, c, m in zip(r.links, r.cad_mass, r.mass, strict=True)
         )
-        + ". A link's own mass is seen only in combinations (a joint's armature with the inertia "
-        "about its axis, a mass with the links beyond it): what the data do not see stays at "
-        f"CAD ({', '.join(r.unidentifiable)}).",
+        + ". A link's own mass is seen only in combinations (a mass with the links beyond it, a "
+        "joint's armature with the inertia about its axis): the parameters outside the base set "
+        f"are held toward CAD ({', '.join(r.unidentifiable)}).",
+        "",
     ]
     return "\n".join(lines)
 
@@ -278,11 +279,12 @@ def plot_rest(r: SlaveModelResult, path: Path, _base: SessionConfig) -> None:
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 3.5))
     width = 0.8 / max(1, len(r.models))
+    n = len(r.models[0].rest_n) if r.models else 0
     for i, m in enumerate(r.models):
-        x = np.arange(len(m.rest_n)) + i * width
-        ax.bar(x, m.rest_n, width, label=m.model)
+        ax.bar(np.arange(n) + i * width, m.rest_n, width, label=m.model)
+    ax.set_xticks(np.arange(n) + 0.4 - width / 2, [str(k + 1) for k in range(n)])
     ax.set_yscale("log")
-    ax.set_xlabel("posture")
-    ax.set_ylabel("estimate at rest (N)")
-    ax.legend(fontsize=8)
+    ax.set_xlabel("posture (held still, nothing in contact)")
+    ax.set_ylabel("estimate's size (N)")
+    ax.legend(fontsize=8, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=3, frameon=False)
     save_figure(fig, path)
