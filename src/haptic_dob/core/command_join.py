@@ -17,6 +17,7 @@ from haptic_dob.core.control import (
     ZERO_FORCE,
     ControlMode,
     Force,
+    HandForce,
     ImpedanceController,
     ImpedanceLaw,
 )
@@ -26,9 +27,6 @@ from haptic_dob.core.control import (
 WARM_SAMPLES = 20
 WARM_WINDOW = 100
 FALLBACKS = ("zero", "OL")
-
-#: the inputs a law may need, by ``ImpedanceLaw.needs``, and the topic each comes on
-NEEDS_TOPIC = {"measured": "wrench_measured", "estimated": "wrench_estimate"}
 
 
 class ForceInput:
@@ -60,10 +58,9 @@ def _quiet(_text: str) -> None:
 class CommandJoin:
     """Command k from the stamp-k inputs its mode needs (the controller's decision, ROS-free).
 
-    Feed the inputs as they come (``wall``, ``joints``, ``measured``, ``estimated``; stamps in
-    integer ns). Each returns the command to send (joint efforts, N or N m) or None: a new command
-    once every input of the newest cycle is there, the same command again for a repeated sample,
-    None while an input is missing or for a stale sample.
+    Feed the inputs as they come (``wall``, ``joints``, ``measured``, ``estimated``; stamps in ns):
+    each returns the command to send (joint efforts, N or N m) once every input of the newest cycle
+    is there, the same again for a repeated sample, None while one is missing or for a stale sample.
 
     Args:
         controller: the law and the model's Jacobian (its ``law`` is replaced by ``set_law``).
@@ -118,10 +115,10 @@ class CommandJoin:
         """``ValueError`` with the reason when ``law`` needs a force input that is not flowing."""
         need, old = law.needs, self.controller.law.needs
         if need is not None and need != old:
-            source = self.measured_in if need == "measured" else self.estimated_in
+            source = self.measured_in if need is HandForce.MEASURED else self.estimated_in
             if not source.flowing(self.newest_ns, self.period_ns):
                 raise ValueError(
-                    f"mode {law.mode.value} needs {NEEDS_TOPIC[need]}, which is not flowing "
+                    f"mode {law.mode.value} needs {need.value}, which is not flowing "
                     f"(fewer than {WARM_SAMPLES} samples in the last {WARM_WINDOW} cycles)"
                 )
 
@@ -166,11 +163,7 @@ class CommandJoin:
         need = self.controller.law.needs
         if need is None:
             return None
-        return (
-            (self.measured_in, NEEDS_TOPIC[need])
-            if need == "measured"
-            else (self.estimated_in, NEEDS_TOPIC[need])
-        )
+        return (self.measured_in if need is HandForce.MEASURED else self.estimated_in), need.value
 
     def pending(self) -> bool:
         """A cycle is open whose command has not been computed."""
@@ -182,11 +175,9 @@ class CommandJoin:
         out = [] if self.desired.stamp == k else ["wrench_desired"]
         if self.needs_q and self.joints_in.stamp != k:
             out.append("joint_states")
-        need = self.controller.law.needs
-        if need == "measured" and self.measured_in.stamp != k:
-            out.append(NEEDS_TOPIC[need])
-        if need == "estimated" and self.estimated_in.stamp != k:
-            out.append(NEEDS_TOPIC[need])
+        force = self.force_input()
+        if force is not None and force[0].stamp != k:
+            out.append(force[1])
         return out
 
     # --- the decision -----------------------------------------------------------------------

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from enum import StrEnum
+from enum import Enum, StrEnum
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -51,6 +51,13 @@ class ControlMode(StrEnum):
             raise ValueError(f"mode must be one of {choices}, got {value!r}") from None
 
 
+class HandForce(Enum):
+    """The hand-force input a law feeds back, by the topic it comes on."""
+
+    MEASURED = "wrench_measured"  # the force sensor's (CL)
+    ESTIMATED = "wrench_estimate"  # the observer's (DOB)
+
+
 @dataclass(frozen=True)
 class ImpedanceLaw:
     """One consistent snapshot of the law's settings: mode, force gain Kf and force limit.
@@ -76,12 +83,12 @@ class ImpedanceLaw:
         object.__setattr__(self, "max_force_n", positive("max_force_n", self.max_force_n))
 
     @property
-    def needs(self) -> str | None:
-        """The hand-force input this mode waits for: ``'measured'``, ``'estimated'`` or None."""
+    def needs(self) -> HandForce | None:
+        """The hand-force input this mode waits for (None in OL)."""
         if self.mode is ControlMode.CL:
-            return "measured"
+            return HandForce.MEASURED
         if self.mode is ControlMode.DOB:
-            return "estimated"
+            return HandForce.ESTIMATED
         return None
 
     def force(self, f_wall: Force, f_measured: Force, f_estimated: Force) -> Force:

@@ -30,6 +30,7 @@ from haptic_dob.core.models.factory import build_model
 from haptic_dob.core.models.phantom import PhantomModel
 from haptic_dob.core.observers.factory import ObserverSettings
 from haptic_dob.core.tip_force import dls_transpose_solve
+from haptic_dob.runtime.configs import urdf_beside
 from haptic_dob.runtime.params import build, load_node_params, node_view, replace_groups
 from haptic_sim.arm.device import ArmDeviceParams, SimulatedArm
 from haptic_sim.hand import HandParams
@@ -87,8 +88,27 @@ class ArmSessionConfig:
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> ArmSessionConfig:
-        """Load a ``ros__parameters`` YAML file (the one the node graph is launched with)."""
-        return cls.from_node_params(load_node_params(path))
+        """Load a ``ros__parameters`` YAML file (the one the node graph is launched with; a
+        relative ``urdf_path`` beside it, as the launcher takes it)."""
+        nodes = load_node_params(path)
+        urdf_beside(nodes, path)
+        return cls.from_node_params(nodes)
+
+
+@dataclass(frozen=True)
+class ArmSessionSummary:
+    """An arm session's headline figures."""
+
+    model: str  # the plant's model class
+    controller: str
+    kf: float
+    stiffness_n_per_m: float
+    observer_gain: float  # N m s/rad
+    duration_s: float
+    seed: int
+    estimate_rms_error_n: float  # RMS of the 3-D tip-force estimate's error
+    max_penetration_m: float
+    in_contact_pct: float
 
 
 @dataclass
@@ -120,26 +140,24 @@ class ArmSessionResult:
     d_hat: np.ndarray
     d_exact: np.ndarray
 
-    def summary(self, settle_s: float = 0.0) -> dict[str, Any]:
-        """Headline figures after ``settle_s`` seconds: force-estimate error (N, RMS of the 3-D
-        error), contact share and deepest penetration (m)."""
+    def summary(self, settle_s: float = 0.0) -> ArmSessionSummary:
+        """Headline figures after ``settle_s`` seconds (at most a quarter of the session)."""
         cfg = self.config
         s = slice(min(round(settle_s * cfg.loop.rate_hz), self.t.size // 4), None)
         err = np.linalg.norm(self.force_estimated[s] - self.tip_force[s], axis=1)
         depth = (self.ee_true[s] - np.asarray(cfg.wall.position)) @ np.asarray(cfg.wall.normal)
-        out: dict[str, Any] = {
-            "model": type(cfg.plant).__name__,
-            "controller": cfg.law.mode.value,
-            "kf": cfg.law.kf,
-            "stiffness_n_per_m": cfg.wall.stiffness_n_per_m,
-            "observer_gain": cfg.observer.gain,
-            "duration_s": self.t.size / cfg.loop.rate_hz,
-            "seed": cfg.loop.seed,
-            "estimate_rms_error_n": float(np.sqrt(np.mean(err * err))),
-            "max_penetration_m": float(max(depth.max(), 0.0)),
-            "in_contact_pct": float(np.mean(depth > 0.0) * 100.0),
-        }
-        return out
+        return ArmSessionSummary(
+            model=type(cfg.plant).__name__,
+            controller=cfg.law.mode.value,
+            kf=cfg.law.kf,
+            stiffness_n_per_m=cfg.wall.stiffness_n_per_m,
+            observer_gain=cfg.observer.gain,
+            duration_s=self.t.size / cfg.loop.rate_hz,
+            seed=cfg.loop.seed,
+            estimate_rms_error_n=float(np.sqrt(np.mean(err * err))),
+            max_penetration_m=float(max(depth.max(), 0.0)),
+            in_contact_pct=float(np.mean(depth > 0.0) * 100.0),
+        )
 
     def save(self, path: str | Path) -> None:
         """Write the arrays to an ``.npz`` file."""

@@ -35,8 +35,8 @@ def command(config: str) -> int:
         label = name if name == "OL" else f"{name} Kf={kf:g}"
         bw, err = THESIS_800[name]
         print(
-            f"{label:<12}{s['bandwidth_hz']:>8.2f} Hz{s['impedance_error_pct']:>10.1f} %"
-            f"{s['estimate_rms_error_n']:>10.3f} N{s['saturated_pct']:>9.1f} %   {bw} Hz, {err} %"
+            f"{label:<12}{s.bandwidth_hz:>8.2f} Hz{s.impedance_error_pct:>10.1f} %"
+            f"{s.estimate_rms_error_n:>10.3f} N{s.saturated_pct:>9.1f} %   {bw} Hz, {err} %"
         )
     print(
         f"OL mass-damper prediction: {mass_damper_band_edge_hz(k, m.mass_kg):.2f} Hz. "

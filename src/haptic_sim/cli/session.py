@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from haptic_dob.cli.common import ArgumentParser, run
 from haptic_dob.core.control import ControlMode
@@ -13,8 +14,10 @@ from haptic_dob.core.environment import VirtualWall
 from haptic_dob.core.validation import nonnegative, positive
 from haptic_dob.runtime.configs import resolve_config
 from haptic_dob.runtime.params import load_node_params, node_view
+from haptic_sim.arm.session import ArmSessionConfig, ArmSessionSummary, run_arm_session
+from haptic_sim.device.batch import BatchSummary, load_session, run_batch, summarize
 from haptic_sim.hand import reference_for_force
-from haptic_sim.slide.session import SessionConfig, run_session
+from haptic_sim.slide.session import SessionConfig, SessionSummary, run_session
 from haptic_sim.slide.stability import law_for
 
 
@@ -31,9 +34,12 @@ def command(
     """Load, override, run, print; raises ``ValueError``/``InputError`` on bad input."""
     path = resolve_config(config)
     model = node_view(load_node_params(path), "device_node").get("model", "slide")
+    if model == "point_mass":
+        overrides = Overrides(controller, kf, stiffness, duration, seed)
+        print_summary(run_cartesian(path, overrides, save), save, as_json)
+        return 0
     if model != "slide":
-        summary = run_arm(path, controller, kf, stiffness, duration, seed, save)
-        print_summary(summary, as_json)
+        print_summary(run_arm(path, controller, kf, stiffness, duration, seed, save), save, as_json)
         return 0
     cfg = SessionConfig.from_yaml(path)
     if controller is not None or kf is not None:
@@ -53,11 +59,9 @@ def command(
     if seed is not None:
         cfg = cfg.replace(loop__seed=int(nonnegative("--seed", seed)))
     result = run_session(cfg)
-    summary = result.summary()
     if save:
         result.save(save)
-        summary["saved"] = save
-    print_summary(summary, as_json)
+    print_summary(result.summary(), save, as_json)
     return 0
 
 
@@ -69,10 +73,8 @@ def run_arm(
     duration: float | None,
     seed: int | None,
     save: str | None,
-) -> dict[str, Any]:
+) -> ArmSessionSummary:
     """A PHANToM or URDF-arm session (``haptic_sim.arm.session``) with the same overrides."""
-    from haptic_sim.arm.session import ArmSessionConfig, run_arm_session
-
     cfg = ArmSessionConfig.from_yaml(path)
     if controller is not None or kf is not None:
         law = cfg.law
@@ -91,15 +93,53 @@ def run_arm(
     if seed is not None:
         cfg = cfg.replace(loop__seed=int(nonnegative("--seed", seed)))
     result = run_arm_session(cfg)
-    summary = result.summary()
     if save:
         result.save(save)
-        summary["saved"] = save
-    return summary
+    return result.summary()
 
 
-def print_summary(summary: dict[str, Any], as_json: bool) -> None:
-    """JSON, or one aligned ``key  value`` line per figure."""
+@dataclass(frozen=True)
+class Overrides:
+    """What the command line changes in a config (None: the config's)."""
+
+    controller: str | None
+    kf: float | None
+    stiffness: float | None
+    duration: float | None
+    seed: int | None
+
+
+def run_cartesian(path: Path, o: Overrides, save: str | None) -> BatchSummary:
+    """A Cartesian point-mass device's session (``haptic_sim.device.batch``), the overrides set
+    as the nodes' parameters (``--stiffness`` leaves the hand's push as the config has it):
+    headline figures of the estimate in contact."""
+    nodes = load_session(path)
+    ctl, env, dev = (
+        nodes.setdefault(n, {}) for n in ("controller_node", "environment_node", "device_node")
+    )
+    if o.controller is not None:
+        ctl["mode"] = o.controller
+    if o.kf is not None:
+        ctl["kf"] = nonnegative("--kf", o.kf)
+    if o.stiffness is not None:
+        env["stiffness_n_per_m"] = positive("--stiffness", o.stiffness)
+    if o.duration is not None:
+        dev["duration_s"] = positive("--duration", o.duration)
+    if o.seed is not None:
+        dev["seed"] = int(nonnegative("--seed", o.seed))
+    record = run_batch(nodes)
+    if save:
+        record.save(save)
+    return summarize(record, nodes)
+
+
+def print_summary(
+    figures: SessionSummary | ArmSessionSummary | BatchSummary, saved: str | None, as_json: bool
+) -> None:
+    """JSON, or one aligned ``key  value`` line per figure (and where the arrays went)."""
+    summary: dict[str, object] = dict(dataclasses.asdict(figures))
+    if saved:
+        summary["saved"] = saved
     if as_json:
         print(json.dumps(summary, indent=2))
         return

@@ -289,7 +289,7 @@ def model_mismatch(
 def _summary(cfg: SessionConfig) -> tuple[float | None, float | None]:
     """(bandwidth Hz, impedance error %) of one batch session."""
     s = run_session(cfg).summary()
-    return s["bandwidth_hz"], s["impedance_error_pct"]
+    return s.bandwidth_hz, s.impedance_error_pct
 
 
 def traces(base: SessionConfig, stiffness: float, kf: float = 100.0) -> dict[str, SessionResult]:

@@ -82,7 +82,7 @@ def cells(base: SessionConfig) -> list[PlannedCell]:
 
 
 def _run(cell: PlannedCell) -> SeedCell:
-    return cell.with_bandwidth(run_session(cell.config).summary()["bandwidth_hz"])
+    return cell.with_bandwidth(run_session(cell.config).summary().bandwidth_hz)
 
 
 def seed_cells(base: SessionConfig, executor: Executor | None = None) -> list[SeedCell]:

@@ -217,7 +217,7 @@ def _measure(job: Job) -> _Measured:
     onset = None
     if onset_walls:
         onset = stability_sweep(list(onset_walls), cfg).onset_stiffness_n_per_m
-    table_bw = res.summary(SETTLE_S)["bandwidth_hz"]
+    table_bw = res.summary(SETTLE_S).bandwidth_hz
     try:
         tr = transparency(
             res.q[k0:], res.force_measured[k0:], cfg.loop.rate_hz, cfg.wall.stiffness_n_per_m

@@ -136,6 +136,26 @@ class SessionConfig:
         return cls.from_node_params(load_node_params(path))
 
 
+@dataclass(frozen=True)
+class SessionSummary:
+    """A session's headline figures. Transparency figures are None when the record is too short
+    or does not move (or the wall has no stiffness)."""
+
+    controller: str
+    kf: float
+    stiffness_n_per_m: float
+    observer_gain: float  # N s/m
+    duration_s: float
+    seed: int
+    estimate_rms_error_n: float  # observer's estimate against the true hand force
+    saturated_pct: float  # samples with the actuator at its limit
+    in_contact_pct: float  # samples inside the wall
+    max_active_energy_j: float  # the passivity observer's largest generated energy
+    bandwidth_hz: float | None
+    impedance_error_pct: float | None
+    coherence_in_band: float | None
+
+
 @dataclass
 class SessionResult:
     """Per-cycle arrays of a session (SI units), all of length N (one row per cycle k).
@@ -161,33 +181,15 @@ class SessionResult:
         """Control period (s)."""
         return 1.0 / self.config.loop.rate_hz
 
-    def summary(self, settle_s: float = 2.0) -> dict[str, Any]:
-        """Headline figures: transparency, force-estimate error, contact, saturation, energy.
-
-        The first ``settle_s`` seconds (the hand's ramp-in; at most a quarter of the session) are
-        left out. Transparency figures are None when the record is too short or does not move.
-        """
+    def summary(self, settle_s: float = 2.0) -> SessionSummary:
+        """Headline figures, leaving out the first ``settle_s`` seconds (the hand's ramp-in; at
+        most a quarter of the session)."""
         cfg = self.config
         fs = cfg.loop.rate_hz
         s = slice(min(round(settle_s * fs), self.t.size // 4), None)
-        out: dict[str, Any] = {
-            "controller": cfg.law.mode.value,
-            "kf": cfg.law.kf,
-            "stiffness_n_per_m": cfg.wall.stiffness_n_per_m,
-            "observer_gain": cfg.observer.gain,
-            "duration_s": self.t.size / fs,
-            "seed": cfg.loop.seed,
-        }
         err = self.force_estimated[s] - self.hand_force[s]
-        out["estimate_rms_error_n"] = float(np.sqrt(np.mean(err * err)))
-        out["saturated_pct"] = float(
-            np.mean(np.abs(self.effort[s]) >= cfg.device.max_force_n * (1 - 1e-9)) * 100.0
-        )
         depth = self.q[s] - float(np.dot(cfg.wall.position, cfg.wall.normal))
-        out["in_contact_pct"] = float(np.mean(depth > 0.0) * 100.0)
-        energy = passivity_observer(self.force_measured[s], self.qd[s], self.dt)
-        out["max_active_energy_j"] = energy.max_active_j
-        out["bandwidth_hz"] = out["impedance_error_pct"] = out["coherence_in_band"] = None
+        tr = None
         if cfg.wall.stiffness_n_per_m > 0.0:
             try:
                 tr = transparency(
@@ -198,11 +200,26 @@ class SessionResult:
                     cfg.wall.damping_n_s_per_m,
                 )
             except ValueError:  # too short for the spectral settings, or no motion
-                return out
-            out["bandwidth_hz"] = tr.bandwidth_hz
-            out["impedance_error_pct"] = tr.impedance_error_pct
-            out["coherence_in_band"] = tr.mean_coherence_in_band
-        return out
+                tr = None
+        return SessionSummary(
+            controller=cfg.law.mode.value,
+            kf=cfg.law.kf,
+            stiffness_n_per_m=cfg.wall.stiffness_n_per_m,
+            observer_gain=cfg.observer.gain,
+            duration_s=self.t.size / fs,
+            seed=cfg.loop.seed,
+            estimate_rms_error_n=float(np.sqrt(np.mean(err * err))),
+            saturated_pct=float(
+                np.mean(np.abs(self.effort[s]) >= cfg.device.max_force_n * (1 - 1e-9)) * 100.0
+            ),
+            in_contact_pct=float(np.mean(depth > 0.0) * 100.0),
+            max_active_energy_j=passivity_observer(
+                self.force_measured[s], self.qd[s], self.dt
+            ).max_active_j,
+            bandwidth_hz=None if tr is None else tr.bandwidth_hz,
+            impedance_error_pct=None if tr is None else tr.impedance_error_pct,
+            coherence_in_band=None if tr is None else tr.mean_coherence_in_band,
+        )
 
     def save(self, path: str | Path) -> None:
         """Write the arrays to an ``.npz`` file."""
@@ -231,37 +248,31 @@ def run_session(config: SessionConfig, cycles: int | None = None) -> SessionResu
     axis = device.model.axis
     ax0, ax1, ax2 = (float(a) for a in axis)
 
-    rec = np.empty((n, 9))
+    x_true, q, qd, effort, command = (np.empty(n) for _ in range(5))
+    wall_force, hand_force, force_measured, force_estimated = (np.empty(n) for _ in range(4))
     for k in range(n):
         s = device.sample()
-        x_true = device.x
+        x_true[k] = device.x
         f_wall, f_est, tau = cycle.step(
             s.stamp_ns, s.q, s.qd, s.effort, s.ee_position, s.ee_velocity, s.wrench_measured
         )
         device.apply(tau)
         fm, fh = s.wrench_measured, s.hand_force
-        rec[k] = (
-            x_true,
-            s.q[0],
-            s.qd[0],
-            s.effort[0],
-            tau[0],
-            f_wall[0] * ax0 + f_wall[1] * ax1 + f_wall[2] * ax2,
-            fh[0] * ax0 + fh[1] * ax1 + fh[2] * ax2,
-            fm[0] * ax0 + fm[1] * ax1 + fm[2] * ax2,
-            f_est[0] * ax0 + f_est[1] * ax1 + f_est[2] * ax2,
-        )
-    cols = rec.T
+        q[k], qd[k], effort[k], command[k] = s.q[0], s.qd[0], s.effort[0], tau[0]
+        wall_force[k] = f_wall[0] * ax0 + f_wall[1] * ax1 + f_wall[2] * ax2
+        hand_force[k] = fh[0] * ax0 + fh[1] * ax1 + fh[2] * ax2
+        force_measured[k] = fm[0] * ax0 + fm[1] * ax1 + fm[2] * ax2
+        force_estimated[k] = f_est[0] * ax0 + f_est[1] * ax1 + f_est[2] * ax2
     return SessionResult(
         config=config,
         t=np.arange(n) * device.dt,
-        x_true=cols[0].copy(),
-        q=cols[1].copy(),
-        qd=cols[2].copy(),
-        effort=cols[3].copy(),
-        command=cols[4].copy(),
-        wall_force=cols[5].copy(),
-        hand_force=cols[6].copy(),
-        force_measured=cols[7].copy(),
-        force_estimated=cols[8].copy(),
+        x_true=x_true,
+        q=q,
+        qd=qd,
+        effort=effort,
+        command=command,
+        wall_force=wall_force,
+        hand_force=hand_force,
+        force_measured=force_measured,
+        force_estimated=force_estimated,
     )

@@ -101,6 +101,6 @@ def test_the_chattering_dob_loop_saturates_in_the_simulation_and_the_quiet_one_d
         hand__amplitude_m=amplitude,
         loop__duration_s=10.0,
     )
-    fast = run_session(base.replace(observer__gain=41.6)).summary()["saturated_pct"]
-    slow = run_session(base.replace(observer__gain=7.0)).summary()["saturated_pct"]
+    fast = run_session(base.replace(observer__gain=41.6)).summary().saturated_pct
+    slow = run_session(base.replace(observer__gain=7.0)).summary().saturated_pct
     assert fast > 20.0 > 1.0 > slow, (fast, slow)

@@ -9,6 +9,7 @@ import pytest
 
 from haptic_dob.core.control import (
     ControlMode,
+    HandForce,
     ImpedanceController,
     ImpedanceLaw,
     joint_effort,
@@ -52,8 +53,8 @@ def test_force_norm_is_limited_with_direction_kept() -> None:
 
 def test_mode_parsing_and_needs() -> None:
     assert ControlMode.parse("dob") is ControlMode.DOB
-    assert ImpedanceLaw("CL").needs == "measured"
-    assert ImpedanceLaw("DOB").needs == "estimated"
+    assert ImpedanceLaw("CL").needs is HandForce.MEASURED
+    assert ImpedanceLaw("DOB").needs is HandForce.ESTIMATED
     assert ImpedanceLaw("OL").needs is None
     with pytest.raises(ValueError, match="mode must be one of OL, CL, DOB"):
         ControlMode.parse("PID")

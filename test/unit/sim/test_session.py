@@ -99,5 +99,5 @@ def test_open_loop_transparency_matches_the_mass_damper(K: float) -> None:
         wall=VirtualWall(K), hand__offset_m=offset, hand__amplitude_m=amplitude
     )
     summary = run_session(cfg).summary()
-    assert summary["in_contact_pct"] > 99.0
-    assert summary["bandwidth_hz"] == pytest.approx(mass_damper_band_edge_hz(K, 0.416), rel=0.10)
+    assert summary.in_contact_pct > 99.0
+    assert summary.bandwidth_hz == pytest.approx(mass_damper_band_edge_hz(K, 0.416), rel=0.10)

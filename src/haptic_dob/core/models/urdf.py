@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from haptic_dob.core.models._pinocchio import PinocchioModel
-from haptic_dob.core.models._pinocchio_urdf import urdf_model
+from haptic_dob.core.models._pinocchio_urdf import add_payload, urdf_model
 from haptic_dob.runtime.params import param
 
 
@@ -37,6 +37,7 @@ class UrdfModel(PinocchioModel):
             ``<haptic_dob:dynamics coulomb_speed>`` from the URDF (0 where it has none).
         armature: rotor inertia reflected to each joint (kg m^2 or kg), scalar or per joint;
             None: each joint's ``<haptic_dob:dynamics armature>`` from the URDF (0 where none).
+        payload_kg: a point mass (kg) at ``tip_frame``'s origin that the URDF does not have.
 
     Raises ``ValueError`` with a clear message for a bad URDF, an unknown frame or joint, or a
     joint that cannot be a coordinate (floating, planar, a mimic joint named in ``joint_names``).
@@ -53,10 +54,13 @@ class UrdfModel(PinocchioModel):
         coulomb: float | Sequence[float] | None = None,
         coulomb_speed: float | Sequence[float] | None = None,
         armature: float | Sequence[float] | None = None,
+        payload_kg: float = 0.0,
     ) -> None:
         if not str(tip_frame):
             raise ValueError("tip_frame must name a frame of the URDF, got ''")
         arm = urdf_model(urdf, str(tip_frame), joint_names)
+        add_payload(arm.model, arm.frame_id, payload_kg)
+        self.payload_kg = float(payload_kg)
         self.tip_frame = str(tip_frame)
         #: per-joint effort limits from the URDF's <limit effort=...> (0 where none)
         self.effort_limits = arm.effort_limits
@@ -78,7 +82,7 @@ class UrdfModel(PinocchioModel):
     def __repr__(self) -> str:
         return (
             f"UrdfModel(tip_frame={self.tip_frame!r}, joint_names={list(self.joint_names)}, "
-            f"gravity={self.gravity_enabled})"
+            f"gravity={self.gravity_enabled}, payload_kg={self.payload_kg})"
         )
 
 
@@ -121,6 +125,7 @@ class UrdfSettings:
             coulomb=_friction(opts.coulomb_n_m),
             coulomb_speed=_friction(opts.coulomb_speed_rad_per_s),
             armature=_friction(opts.armature_kg_m2),
+            payload_kg=opts.payload_kg,
         )
 
 
@@ -183,5 +188,14 @@ class UrdfOptions:
             "kg m^2",
             0.0,
             1e3,
+        ),
+    )
+    payload_kg: float = field(
+        default=0.0,
+        metadata=param(
+            "a point mass at tip_frame's origin that the URDF does not have (a handle, a tool)",
+            "kg",
+            0.0,
+            100.0,
         ),
     )
