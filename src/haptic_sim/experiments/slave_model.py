@@ -59,6 +59,7 @@ def slave_runs(_base_config: Path, seed: int = 0, quick: bool = False) -> list[G
         clock_mode="lockstep",
         duration_s=QUICK_SECONDS if quick else SECONDS,
         wait_for=["slave_controller_node"],
+        command_source="slave_controller_node",  # the slave's law commands it, as in teleop
         start_with=[],
         **{"contact.stiffness_n_per_m": 0.0},
     )
