@@ -2,8 +2,8 @@
 
 H1 estimator (Fite et al.): ``Z_hat(f) = S_xF(f) / S_xx(f)``, the cross-spectral density of motion x
 (position, m) and hand force F (N) over the auto-spectral density of x, both by Welch averaging
-(``scipy.signal.csd`` / ``welch``): Hann window, ``segment_s`` long segments (default 2 s, so
-0.5 Hz resolution at any rate; a 38 s record averages 37 segments), 50 % overlap, each
+(``scipy.signal.csd`` / ``welch``): Hann window, ``segment_s`` long segments (default 4 s, so
+0.25 Hz resolution at any rate; a 38 s record averages 18 segments), 50 % overlap, each
 segment's mean removed.
 
 Transparency ``T(f) = Z_hat / Z_d``. The bandwidth is the first frequency, from the lowest non-zero
@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike
 from haptic_dob.core.validation import nonnegative, positive
 
 BAND_DB = 3.0
-DEFAULT_SEGMENT_S = 2.0
+DEFAULT_SEGMENT_S = 4.0
 DEFAULT_FMAX_HZ = 10.0
 
 
@@ -44,6 +44,11 @@ class TransparencyResult:
     error_per_bin: np.ndarray  # |Z_d - Z_hat| / |Z_d| per bin (fraction)
     segment_s: float
     fmax_hz: float
+
+    @property
+    def band_below_first_bin(self) -> bool:
+        """True when |T| is outside the band at the first bin: the band ends below it."""
+        return (not self.band_limited_by_fmax) and self.bandwidth_hz <= float(self.freqs_hz[0])
 
     @property
     def magnitude_db(self) -> np.ndarray:
