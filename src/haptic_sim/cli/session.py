@@ -14,7 +14,6 @@ from haptic_dob.core.validation import nonnegative, positive
 from haptic_dob.runtime.configs import resolve_config
 from haptic_dob.runtime.params import load_node_params, node_view
 from haptic_sim.arm.session import ArmSessionConfig, ArmSessionSummary, run_arm_session
-from haptic_sim.hand import reference_for_force
 from haptic_sim.slide.session import SessionConfig, SessionSummary, run_session
 from haptic_sim.slide.stability import law_for
 
@@ -45,9 +44,6 @@ def command(
         k = positive("--stiffness", stiffness)
         w = cfg.wall
         cfg = cfg.replace(wall=VirtualWall(k, w.damping_n_s_per_m, w.position, w.normal))
-        if cfg.hand.behaviour == "semi_random":
-            offset, amplitude = reference_for_force(k, cfg.hand.stiffness_n_per_m)
-            cfg = cfg.replace(hand__offset_m=offset, hand__amplitude_m=amplitude)
     if duration is not None:
         cfg = cfg.replace(loop__duration_s=positive("--duration", duration))
     if seed is not None:
