@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from haptic_dob.analysis.linear_loop import chatter_gain
 from haptic_sim.experiments import thesis
 from haptic_sim.experiments.dob_mechanism import (
     GRIPS,
@@ -15,7 +14,8 @@ from haptic_sim.experiments.dob_mechanism import (
     KickPoint,
     first_vibrating_with,
 )
-from haptic_sim.experiments.plan import CH7_CONTROLLERS
+from haptic_sim.experiments.observer_gain import ACCURACY_GAIN, gain_for
+from haptic_sim.experiments.plan import CH7_CONTROLLERS, CH7_WALLS
 from haptic_sim.experiments.records import (
     ExperimentResults,
     GraphOnset,
@@ -25,8 +25,9 @@ from haptic_sim.experiments.records import (
 )
 from haptic_sim.experiments.results import bound, ch7_grid
 from haptic_sim.experiments.stability_map import MapPoint
+from haptic_sim.hand import depth_reference
 from haptic_sim.slide.session import SessionConfig
-from haptic_sim.slide.stability import VIBRATION_RMS_M
+from haptic_sim.slide.stability import THRESHOLD_PLATEAU_M
 
 
 def fmt(v: float | None, spec: str = ".2f", none: str = "–") -> str:
@@ -67,7 +68,9 @@ def ch7_tables(rows: list[RunAnalysis]) -> str:
             for w in walls:
                 r = cells.get((mode, kf, w))
                 ref = thesis.cell(mode, kf, w)[idx]
-                cols.append(f"{fmt(None if r is None else value(r), spec)} / {fmt(ref, 'g')}")
+                floor = "< " if idx == 0 and r is not None and r.band_below_first_bin else ""
+                got = fmt(None if r is None else value(r), spec)
+                cols.append(f"{floor}{got} / {fmt(ref, 'g')}")
             out.append(f"| {label(mode, kf)} | " + " | ".join(cols) + " |")
         out.append("")
     return "\n".join(out)
@@ -103,8 +106,9 @@ def ch6_tap_table(taps: list[TapSweep]) -> str:
     """The tap protocol: each wall's residual motion and the first wall that keeps vibrating."""
     lines = [
         "**With the plant's friction, tapped** (3 N for 20 ms; motion 2-3 s after the tap, um RMS "
-        f"about its trend, at its dominant frequency; vibrating above {VIBRATION_RMS_M * 1e6:g} "
-        "um):",
+        "about its trend, at its dominant frequency; vibrating where the hand feels it: its peak "
+        f"above the detection threshold at that frequency, {THRESHOLD_PLATEAU_M * 1e6:g} um up to "
+        "40 Hz):",
         "",
         "| controller | residual motion per wall (N/m: um) | first wall that keeps vibrating "
         "(N/m) | thesis (N/m) |",
@@ -132,8 +136,9 @@ def ch7_console(rows: list[RunAnalysis]) -> list[str]:
     out = [f"{'controller':<12}{'wall':>9}{'bandwidth':>11}{'imp. error':>12}   thesis"]
     for r in sorted(rows, key=order):
         bw, err = thesis.cell(r.mode, r.kf, r.wall)
+        got = ("<" if r.band_below_first_bin else "") + fmt(r.bandwidth_hz)
         out.append(
-            f"{r.controller_label:<12}{r.wall:>5g} N/m{fmt(r.bandwidth_hz):>8} Hz"
+            f"{r.controller_label:<12}{r.wall:>5g} N/m{got:>8} Hz"
             f"{fmt(r.impedance_error_pct, '.1f'):>10} %   {fmt(bw, 'g')} Hz, {fmt(err, 'g')} %"
         )
     return out
@@ -208,7 +213,8 @@ def dob_tables(d: DobStudy) -> str:
     lines += [
         "",
         f"**Tap grid** (DOB Kf = 100, chapter 6's tap in batch; residual motion 2-3 s after the "
-        f"tap, um RMS; vibrating above {VIBRATION_RMS_M * 1e6:g} um):",
+        "tap, um RMS; vibrating where the hand feels it: its peak above the detection threshold "
+        f"at its frequency, {THRESHOLD_PLATEAU_M * 1e6:g} um up to 40 Hz):",
         "",
         "| c (N s/m) | Coulomb (N) | "
         + " | ".join(f"{w:g}" for w in WALLS)
@@ -271,13 +277,13 @@ def config_table(res: ExperimentResults, base: SessionConfig) -> str:
     """The one plant and the one observer configuration every part runs, and what each part sets
     on top (the hand, the wall, the protocol)."""
     m, s, h, d, o = base.model, base.sensor, base.hand, base.device, base.observer
-    chatter = chatter_gain(
-        100.0,
-        m.mass_kg,
-        m.viscous_n_s_per_m,
-        1.0 / base.loop.rate_hz,
-        amplifier_lag_s=d.amplifier_lag_s,
+    gains = ", ".join(
+        f"Kf = {kf:g}: {gain_for(kf, ACCURACY_GAIN, base)[0]:g} (chatter above "
+        f"{fmt(gain_for(kf, ACCURACY_GAIN, base)[1], '.1f', 'none')})"
+        for kf in (1.0, 2.0, 25.0, 100.0)
     )
+    ref = depth_reference(h, tuple(CH7_WALLS), m.mass_kg, m.viscous_n_s_per_m, d.max_force_n)
+    pushes = ", ".join(f"{ref.push_n[w]:.2f} N at {w:g}" for w in CH7_WALLS)
     rows = [
         (
             "simulated slide (its truth, `plant.*`)",
@@ -292,11 +298,12 @@ def config_table(res: ExperimentResults, base: SessionConfig) -> str:
             "runs/ch4_step_2p4/bag`) to 4 digits (chapter 4 checks it)",
         ),
         (
-            "observer, every chapter",
-            f"c = {o.gain:g} N s/m (m/c = {1e3 * m.mass_kg / o.gain:.0f} ms, corner "
-            f"{o.gain / (2 * math.pi * m.mass_kg):.1f} Hz): the fastest whole gain below "
-            f"{fmt(chatter, '.1f')} N s/m, above which DOB at the thesis's Kf = 100 chatters at "
-            f"the sample rate (the DOB section); output limit {o.output_limit} N",
+            "observer gain c (N s/m), per Kf",
+            f"{gains}: the gain whose estimate is closest to the force sensor in 5.3's free and "
+            f"wall sessions ({ACCURACY_GAIN:g}), or the fastest whole gain below the one at which "
+            "DOB at that Kf chatters at the sample rate if that is smaller "
+            "(`haptic_sim.experiments.observer_gain`; the node's default, for any Kf, is "
+            f"{o.gain:g}); output limit {o.output_limit} N",
         ),
         ("loop", f"{base.loop.rate_hz:g} Hz, {base.loop.substeps} physics sub-steps, lockstep"),
         ("actuator", f"saturation {d.max_force_n} N, encoder {d.encoder_resolution_m} m"),
@@ -308,8 +315,13 @@ def config_table(res: ExperimentResults, base: SessionConfig) -> str:
         (
             "hand, ch. 5 and 7",
             f"{h.behaviour}: mass {h.mass_kg} kg, grip {h.stiffness_n_per_m} N/m, "
-            f"damping {h.damping_n_s_per_m} N s/m, band {h.band_low_hz}-{h.band_high_hz} Hz, push "
-            f"and swing scaled to the wall; seed {res.seed}",
+            f"damping {h.damping_n_s_per_m} N s/m; one reference at every wall, a depth (thesis "
+            f"7.3.2): offset {1e3 * h.offset_m:g} mm, std {1e3 * h.amplitude_m:g} mm (pushing "
+            f"{pushes} N/m: half the actuator's {d.max_force_n:g} N at the stiffest, the slide in "
+            f"contact over 3 sigma at every wall; `haptic_sim.hand.depth_reference`); band "
+            f"{h.band_low_hz}-{h.band_high_hz} Hz rolled off above {h.rolloff_hz:g} Hz, the end "
+            'of voluntary motion (Brooks 1990, "Telerobotic response requirements"); seed '
+            f"{res.seed}",
         ),
         (
             "hand, ch. 6",
