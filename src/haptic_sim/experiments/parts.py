@@ -259,13 +259,16 @@ SWEEPS: Experiment[sweeps.SweepStudy] = Experiment(
     heading="Table 7.1's cells that stay off, against the parameter responsible (batch)",
     intro="Controllers of Table 7.1 in the chapter-7 session (40 s, the hand's seed 0, "
     "as chapter 7's default), with one parameter swept from the chapter-7 value: "
-    "the hand's grip damping at 2400 N/m, the hand's depth at 80 N/m, the observer gain and "
+    "the hand's grip damping at 2400 N/m (and, for OL with a loose grip, the friction), the "
+    "hand's depth at 80 N/m, the observer gain and "
     "the plant's low-speed friction at every wall (DOB), the force sensor's bandwidth at 1600 "
     "and 2400 N/m (CL): each cell that stays off has its sweep. Then the whole table for three "
     "seeds of the hand and their median.",
     body=lambda r, _base: [
         sweeps.sweep_table(r, sweeps.GRIP),
         sweeps_report.grip_text(r),
+        sweeps.sweep_table(r, sweeps.VIBRATING),
+        sweeps_report.vibrating_text(r),
         sweeps.sweep_table(r, sweeps.DEPTH),
         sweeps_report.depth_text(r),
         sweeps.sweep_table(r, sweeps.OBSERVER),

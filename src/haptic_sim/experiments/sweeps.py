@@ -3,6 +3,10 @@
 - **2400 N/m against the hand's grip damping.** The bandwidth is the first frequency where the
   rendered impedance leaves the 3 dB band around the wall's. At 2400 N/m OL renders the wall
   soft across the whole band, so that edge is ill-conditioned and follows the hand's grip.
+- **OL at 2400 N/m, a loose grip, against Coulomb friction.** The thesis's user could sustain
+  OL vibration at 2400 N/m (6.3); the simulated friction stops it. Without friction (plant and
+  model) and without grip damping the wall keeps vibrating through the session: what that does
+  to its band.
 - **80 N/m against the hand's depth.** The depth-regulating hand pushes a soft wall only a
   little (0.47 N at 80 N/m, thesis 7.3.2: "close to the frictional force"); the reference's
   offset and amplitude scaled together show what a deeper push does to the friction-dominated
@@ -71,6 +75,14 @@ def _observer_gain(cfg: SessionConfig, mode: str, kf: float, gain: float) -> Ses
     return _law(cfg, mode, kf).replace(observer__gain=gain)
 
 
+def _loose_coulomb(cfg: SessionConfig, mode: str, kf: float, coulomb: float) -> SessionConfig:
+    """The chapter-7 law with a loose grip (no damping), Coulomb friction (N) at ``coulomb`` in
+    the plant and the observer's model."""
+    return _law(cfg, mode, kf).replace(
+        hand__damping_n_s_per_m=0.0, device__coulomb_n=coulomb, model__coulomb_n=coulomb
+    )
+
+
 def _stiction(cfg: SessionConfig, mode: str, kf: float, ratio: float) -> SessionConfig:
     """The chapter-7 law, the plant's breakaway friction at ``ratio`` times Coulomb."""
     return _law(cfg, mode, kf).replace(device__stiction_ratio=ratio)
@@ -91,6 +103,10 @@ def _unit_scale(_b: SessionConfig, _kf: float) -> float:
 
 def _gain(b: SessionConfig, kf: float) -> float:
     return gain_at(kf, b)
+
+
+def _coulomb(b: SessionConfig, _kf: float) -> float:
+    return b.device.coulomb_n
 
 
 def _stiction_ratio(b: SessionConfig, _kf: float) -> float:
@@ -131,6 +147,15 @@ class Sweep:
 
 
 GRIP = Sweep("grip", (2400.0,), "grip damping (N s/m)", _hand_damping, (5.0, 2.0), _grip)
+VIBRATING = Sweep(
+    "vibrating",
+    (2400.0,),
+    "Coulomb friction of the plant and the model (N), the grip without damping",
+    _coulomb,
+    (0.0,),
+    _loose_coulomb,
+    (("OL", 0.0),),
+)
 DEPTH = Sweep(
     "depth", (80.0,), "hand's depth (times the configuration's)", _unit_scale, (2.0, 4.0), _depth
 )
@@ -162,7 +187,7 @@ SENSOR = Sweep(
     (("CL", 2.0),),
     (400.0, 500.0, 600.0, 700.0, 800.0, 900.0, 1000.0),
 )
-SWEEPS = (GRIP, DEPTH, OBSERVER, FRICTION, SENSOR)
+SWEEPS = (GRIP, VIBRATING, DEPTH, OBSERVER, FRICTION, SENSOR)
 
 
 @dataclass(frozen=True)
