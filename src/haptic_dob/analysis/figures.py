@@ -48,13 +48,14 @@ def analyze_arrays(
     """Transparency, energy, contact and vibration of motion x (m), hand force (N), v (m/s).
 
     ``penetration`` (m, > 0 in the wall) gives the contact share; the record should already
-    leave out what is to be left out.
+    leave out what is to be left out. ``segment_s`` is the transparency's Welch segment; the
+    vibration detector keeps its own.
     """
     dt = 1.0 / fs_hz
     energy = passivity_observer(force, velocity, dt)
     touching = None if penetration is None else penetration > 0.0
     contact = None if touching is None else float(np.mean(touching) * 100.0)
-    osc = oscillation(x, fs_hz, touching, oscillation_settings, segment_s)
+    osc = oscillation(x, fs_hz, touching, oscillation_settings)  # its own 2 s Welch segments
     tr, problem = None, None
     if stiffness_n_per_m is None:
         problem = "no wall stiffness recorded (pass --stiffness)"

@@ -6,9 +6,11 @@ segments with the recorded parameters (``haptic_dob.bag.segments``) and analyses
 
 Per segment, the first ``settle_s`` (first segment: the hand's ramp-in) or ``transient_s`` (after
 a parameter change) are left out, at most a quarter of the segment, as
-``SessionResult.summary()`` does. Transparency uses the wall's recorded stiffness and damping
-(or ``stiffness_n_per_m`` when given) with ``haptic_dob.analysis.transparency``; the energy is the
-passivity observer of hand force and velocity (``haptic_dob.analysis.passivity_observer``).
+``SessionResult.summary()`` does. A bag none of whose segments gives a transparency or a pulse
+response (a push-and-hold session's) is an error. Transparency uses the wall's recorded
+stiffness and damping (or ``stiffness_n_per_m`` when given) with
+``haptic_dob.analysis.transparency``; the energy is the passivity observer of hand force and
+velocity (``haptic_dob.analysis.passivity_observer``).
 """
 
 from __future__ import annotations
@@ -134,7 +136,7 @@ def analyze_bag(
                 perturbation=pulse,
             )
         )
-    if all(r.figures.transparency is None for r in results):
+    if all(r.figures.transparency is None and r.perturbation is None for r in results):
         r = max(results, key=lambda r: r.analysed_s)
         left_out = r.analysed_from_s - r.start_s
         where = (

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+from haptic_dob.analysis.transparency import DEFAULT_SEGMENT_S
 from haptic_sim.experiments import thesis
 from haptic_sim.experiments.dob_mechanism import (
     GRIPS,
@@ -108,7 +109,8 @@ def ch6_tap_table(taps: list[TapSweep]) -> str:
         "**With the plant's friction, tapped** (3 N for 20 ms; motion 2-3 s after the tap, um RMS "
         "about its trend, at its dominant frequency; vibrating where the hand feels it: its peak "
         f"above the detection threshold at that frequency, {THRESHOLD_PLATEAU_M * 1e6:g} um up to "
-        "40 Hz):",
+        '40 Hz, after Bolanowski, Gescheider, Verrillo and Checkosky 1988, "Four channels '
+        'mediate the mechanical aspects of touch"):',
         "",
         "| controller | residual motion per wall (N/m: um) | first wall that keeps vibrating "
         "(N/m) | thesis (N/m) |",
@@ -306,6 +308,21 @@ def config_table(res: ExperimentResults, base: SessionConfig) -> str:
             f"{o.gain:g}); output limit {o.output_limit} N",
         ),
         ("loop", f"{base.loop.rate_hz:g} Hz, {base.loop.substeps} physics sub-steps, lockstep"),
+        (
+            "transparency analysis",
+            f"H1 (Welch, Hann, {DEFAULT_SEGMENT_S:g} s segments: {1 / DEFAULT_SEGMENT_S:g} Hz "
+            "bins, 50 % overlap) after the first 2 s; a band whose first bin is already outside "
+            f"the 3 dB band ends below it and is shown `< {1 / DEFAULT_SEGMENT_S:g}` (a floor, "
+            "never within 15 % of the thesis)",
+        ),
+        (
+            "vibration felt (ch. 6's tap)",
+            "the residual's peak above the vibrotactile detection threshold at its frequency: "
+            f"{THRESHOLD_PLATEAU_M * 1e6:g} um up to 40 Hz (the non-Pacinian I channel), the "
+            "Pacinian channel's U above (Bolanowski, Gescheider, Verrillo and Checkosky 1988, "
+            '"Four channels mediate the mechanical aspects of touch"; thesis 6.2: the user '
+            "judged by feel)",
+        ),
         ("actuator", f"saturation {d.max_force_n} N, encoder {d.encoder_resolution_m} m"),
         (
             "force sensor",
