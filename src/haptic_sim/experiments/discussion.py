@@ -205,7 +205,8 @@ def ch7_differences(rows: list[RunAnalysis]) -> list[str]:
         ref = thesis.cell(r.mode, r.kf, r.wall)[0]
         got = r.bandwidth_hz
         if ref is not None and got is not None and abs(got - ref) > DEPARTURE * ref:
-            far.append(f"{r.where} ({got:.2f} vs {ref:g})")
+            floor = "< " if r.band_below_first_bin else ""
+            far.append(f"{r.where} ({floor}{got:.2f} vs {ref:g})")
     out = []
     if far:
         out.append(

@@ -156,18 +156,33 @@ def sensor_text(r: SweepStudy) -> str:
 def differences(r: SweepStudy) -> list[str]:
     """The paragraphs for "where the simulation differs" (a sweep not run adds none)."""
     out = []
-    if r.of(GRIP.name, "OL", 0.0):
+    grip = r.of(GRIP.name, "OL", 0.0)
+    if grip:
+        narrowest = min(grip, key=lambda c: c.bandwidth_hz or 0.0)
+        vib = r.of(VIBRATING.name, "OL", 0.0)
+        shaken = (
+            f"; a wall kept vibrating (no Coulomb friction, a loose grip) still gives "
+            f"{_band(vib[-1])}"
+            if len(vib) > 1
+            else ""
+        )
         out.append(
             "- **OL at 2400 N/m: no mechanism found for the thesis's 0.6 Hz.** The simulated OL "
             "renders that wall soft across the band but keeps a band of several Hz whatever the "
-            "grip (the sweeps section); with the plant's friction no OL wall keeps vibrating "
-            "after a tap (chapter 6), while the thesis's user could sustain OL vibration there."
+            f"grip (at least {_band(narrowest)}){shaken} (the sweeps section); with the plant's "
+            "friction no OL wall keeps vibrating after a tap (chapter 6), while the thesis's user "
+            "could sustain OL vibration there."
         )
-    if r.of(DEPTH.name, "OL", 0.0):
+    depth = {(c.mode, c.kf): c for c in r.cells if c.sweep == DEPTH.name and c.value == 1.0}
+    if depth:
+        per = ", ".join(
+            f"{label(m, kf)} {_band(c)} (coherence {fmt(c.coherence_in_band)})"
+            for (m, kf), c in depth.items()
+        )
         out.append(
-            "- **The 80 N/m column is friction's.** The depth-regulating hand pushes the soft "
-            "wall about as hard as the friction (thesis 7.3.2), and every controller's cell there "
-            "is a stick-slip record of low coherence (the sweeps section)."
+            "- **At 80 N/m the hand pushes about as hard as the friction** (thesis 7.3.2: "
+            f'"close to the frictional force"): {per}; a deeper push moves those cells (the '
+            "sweeps section's depth table)."
         )
     if r.of(OBSERVER.name, "DOB", 25.0):
         out.append(

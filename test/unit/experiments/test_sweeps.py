@@ -130,7 +130,10 @@ def test_the_tables_and_the_text_come_from_the_cells() -> None:
     assert "OL x1: < 0.25 Hz (coh. 0.09), x4: 1.29 Hz (coh. 0.90)" in sweeps_report.depth_text(r)
     assert "DOB Kf=1: c = 146 at 1600 N/m" in sweeps_report.observer_text(r)
     diffs = sweeps_report.differences(r)
-    assert any("no mechanism found" in d for d in diffs)
+    assert any("no mechanism found" in d and "(at least 4.90 Hz)" in d for d in diffs)
+    assert any(
+        "close to the frictional force" in d and "OL < 0.25 Hz (coherence 0.09)" in d for d in diffs
+    )
     assert any("seed 0: 1, seed 1: 1, seed 2: 0; their median: 1 of 1" in d for d in diffs)
     table = spread.spread_table(r.seeds)
     assert "| OL, 800 N/m | 3.86* | 4.07* | < 0.25 | 3.86* | 3.8 |" in table
