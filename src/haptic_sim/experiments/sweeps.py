@@ -16,8 +16,8 @@
   gain rule (``observer_gain``) gives Kf = 25 the fastest gain that does not chatter.
 - **Every wall against the plant's low-speed friction (DOB).** The thesis (7.3.3.1) blames the
   high-gain DOB's errors on friction at low speed that the observer's model leaves out; the
-  breakaway ratio is swept up to 2.5, above which chapter 4.3's 0.6 N sine could not move the
-  slide (which the thesis's device tracked).
+  breakaway ratio is swept up to 2.5 (0.6 N), where chapter 4.3's 0.6 N sine no longer breaks
+  the slide away (the thesis's device tracked it).
 - **1600 and 2400 N/m against the force sensor's bandwidth (CL).** CL's band follows the mass line
   ``m / (1 + Kf)`` above the thesis's 4.5 Hz; a slower sensor lowers it only when it also lowers
   the CL onset of chapter 6's linear protocol below the thesis's 800 N/m (the onset column).
@@ -37,10 +37,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from haptic_dob.analysis.transparency import transparency
-from haptic_sim.experiments import spread, thesis
+from haptic_sim.experiments import spread
 from haptic_sim.experiments.observer_gain import gain_at
 from haptic_sim.experiments.plan import CH7_CONTROLLERS, CH7_WALLS
-from haptic_sim.experiments.tables import fmt
 from haptic_sim.slide.session import SessionConfig, run_session
 from haptic_sim.slide.stability import law_for
 from haptic_sim.slide.stability import sweep as stability_sweep
@@ -338,56 +337,3 @@ def study(base: SessionConfig, executor: Executor | None = None) -> SweepStudy:
             for c in seeds
         ],
     )
-
-
-def label(mode: str, kf: float) -> str:
-    """``OL``, ``CL Kf=2``..."""
-    return mode if mode == "OL" else f"{mode} Kf={kf:g}"
-
-
-def _cell_text(c: SweepCell) -> str:
-    onset = "" if c.onset_n_per_m is None else f"; onset {c.onset_n_per_m:.0f}"
-    return (
-        f"{'< ' if c.below_first_bin else ''}{fmt(c.bandwidth_hz)} ({fmt(c.coherence_in_band)}); "
-        f"{fmt(c.first_bin_db, '+.1f')} / {fmt(c.mean_db_to_5hz, '+.1f')}; "
-        f"{c.saturated_pct:.0f} %{onset}"
-    )
-
-
-def sweep_table(r: SweepStudy, sweep: Sweep) -> str:
-    """One sweep's table: a row per controller and wall, a column per value (in the order run),
-    the thesis's cell last; chapter 6's linear onset per value where the sweep measures it."""
-    values = list(dict.fromkeys(c.value for c in r.cells if c.sweep == sweep.name))
-    if not values:
-        return ""
-    walls = ", ".join(f"{w:g}" for w in sweep.walls)
-    lines = [
-        f"**{walls} N/m against the {sweep.parameter}** (in bold, chapter 7's value): "
-        "bandwidth in Hz (coherence in the band); |Z_hat / Z_d| at the first bin / its mean up "
-        "to 5 Hz (dB); time at the force limit"
-        + ("; chapter 6's linear onset (N/m)" if sweep.onset_walls else "")
-        + ":",
-        "",
-        "| | " + " | ".join(f"{v:g}" for v in values) + " | thesis (Hz) |",
-        "|---|" + "---|" * (len(values) + 1),
-    ]
-    for mode, kf in sweep.controllers:
-        for wall in sweep.walls:
-            run = r.of(sweep.name, mode, kf, wall)
-            if not run:
-                continue
-            by_value = {c.value: c for c in run}
-            cols = [
-                "-"
-                if v not in by_value
-                else (
-                    f"**{_cell_text(by_value[v])}**"
-                    if v == run[0].value
-                    else _cell_text(by_value[v])
-                )
-                for v in values
-            ]
-            ref = thesis.cell(mode, kf, wall)[0]
-            name = label(mode, kf) + ("" if len(sweep.walls) == 1 else f", {wall:g} N/m")
-            lines.append(f"| {name} | " + " | ".join(cols) + f" | {fmt(ref, 'g')} |")
-    return "\n".join(lines) + "\n"

@@ -13,11 +13,64 @@ from haptic_sim.experiments.sweeps import (
     OBSERVER,
     SENSOR,
     VIBRATING,
+    Sweep,
     SweepCell,
     SweepStudy,
-    label,
 )
 from haptic_sim.experiments.tables import fmt
+
+
+def label(mode: str, kf: float) -> str:
+    """``OL``, ``CL Kf=2``..."""
+    return mode if mode == "OL" else f"{mode} Kf={kf:g}"
+
+
+def _cell_text(c: SweepCell) -> str:
+    onset = "" if c.onset_n_per_m is None else f"; onset {c.onset_n_per_m:.0f}"
+    return (
+        f"{'< ' if c.below_first_bin else ''}{fmt(c.bandwidth_hz)} ({fmt(c.coherence_in_band)}); "
+        f"{fmt(c.first_bin_db, '+.1f')} / {fmt(c.mean_db_to_5hz, '+.1f')}; "
+        f"{c.saturated_pct:.0f} %{onset}"
+    )
+
+
+def sweep_table(r: SweepStudy, sweep: Sweep) -> str:
+    """One sweep's table: a row per controller and wall, a column per value (in the order run),
+    the thesis's cell last; chapter 6's linear onset per value where the sweep measures it."""
+    values = list(dict.fromkeys(c.value for c in r.cells if c.sweep == sweep.name))
+    if not values:
+        return ""
+    walls = ", ".join(f"{w:g}" for w in sweep.walls)
+    lines = [
+        f"**{walls} N/m against the {sweep.parameter}** (in bold, chapter 7's value): "
+        "bandwidth in Hz (coherence in the band); |Z_hat / Z_d| at the first bin / its mean up "
+        "to 5 Hz (dB); time at the force limit"
+        + ("; chapter 6's linear onset (N/m)" if sweep.onset_walls else "")
+        + ":",
+        "",
+        "| | " + " | ".join(f"{v:g}" for v in values) + " | thesis (Hz) |",
+        "|---|" + "---|" * (len(values) + 1),
+    ]
+    for mode, kf in sweep.controllers:
+        for wall in sweep.walls:
+            run = r.of(sweep.name, mode, kf, wall)
+            if not run:
+                continue
+            by_value = {c.value: c for c in run}
+            cols = [
+                "-"
+                if v not in by_value
+                else (
+                    f"**{_cell_text(by_value[v])}**"
+                    if v == run[0].value
+                    else _cell_text(by_value[v])
+                )
+                for v in values
+            ]
+            ref = thesis.cell(mode, kf, wall)[0]
+            name = label(mode, kf) + ("" if len(sweep.walls) == 1 else f", {wall:g} N/m")
+            lines.append(f"| {name} | " + " | ".join(cols) + f" | {fmt(ref, 'g')} |")
+    return "\n".join(lines) + "\n"
 
 
 def _band(c: SweepCell) -> str:

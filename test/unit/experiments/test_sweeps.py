@@ -51,8 +51,8 @@ def test_the_high_gain_dob_band_follows_the_observer_gain() -> None:
 
 
 def test_more_breakaway_friction_than_the_observer_knows_narrows_the_dob_bands() -> None:
-    """DOB Kf=1 at 800 N/m: with the plant's breakaway friction at 2.5 times Coulomb (the most
-    that still lets chapter 4.3's 0.6 N sine move the slide) the observer underestimates the
+    """DOB Kf=1 at 800 N/m: with the plant's breakaway friction at 2.5 times Coulomb (0.6 N, the
+    bound where chapter 4.3's 0.6 N sine no longer moves the slide) the observer underestimates the
     force at low speed and the wall is rendered softer (thesis 7.3.3.1): the mean rendering up
     to 5 Hz falls by more than 1 dB and the band narrows (measured 4.91 to 2.48 Hz, -1.2 to
     -2.4 dB)."""
@@ -111,16 +111,16 @@ def test_the_tables_and_the_text_come_from_the_cells() -> None:
             for s, bw in ((0, 3.86), (1, 4.07), (2, 0.25))
         ],
     )
-    grip = sweeps.sweep_table(r, GRIP)
+    grip = sweeps_report.sweep_table(r, GRIP)
     assert "| | 10 | 5 | thesis (Hz) |" in grip  # the values run, in their order
     assert "| OL | **6.04 (0.85); -1.6 / -1.8; 0 %** | 4.90 (0.64); -1.6 / -1.8; 0 % | 0.6 |" in (
         grip
     )  # chapter 7's value in bold
     assert "CL" not in grip.split("thesis (Hz) |")[1]  # a controller not swept has no row
-    depth = sweeps.sweep_table(r, DEPTH)
+    depth = sweeps_report.sweep_table(r, DEPTH)
     assert "| OL | **< 0.25 (0.09); -3.1 / -1.8; 0 %** | 1.29 (0.90)" in depth
-    assert sweeps.sweep_table(r, SENSOR) == ""  # not run: no table
-    obs = sweeps.sweep_table(r, OBSERVER)
+    assert sweeps_report.sweep_table(r, SENSOR) == ""  # not run: no table
+    obs = sweeps_report.sweep_table(r, OBSERVER)
     assert "| | 146 | 7 | 30 | thesis (Hz) |" in obs
     # each row's own chapter-7 value is the bold one
     assert "| DOB Kf=1, 1600 N/m | **6.00 (0.92); -1.6 / -1.8; 0 %** | 10.00 (0.76)" in obs
