@@ -3,9 +3,9 @@
 The thesis measured each cell once, with one user's 40 s of motion; chapter 7 here runs one
 seed of the simulated hand. Running the same cells for other seeds (batch, the graph's cycle
 timing: seed 0 is chapter 7's own table to the bit) shows how much of a cell's distance from the
-thesis is the hand's draw, how many cells fall within 15 % for each seed, and how many the
-median of the seeds puts within 15 %. A band that ends below the first frequency bin is a
-resolution floor, not a measured edge: it never counts as within 15 %.
+thesis is the hand's draw. This module runs them and takes their median; ``spread_report`` sets
+them beside the thesis (this one never reads it). A band that ends below the first frequency
+bin is a resolution floor, not a measured edge: its median is no value.
 """
 
 from __future__ import annotations
@@ -14,16 +14,13 @@ import statistics
 from concurrent.futures import Executor
 from dataclasses import dataclass
 
-from haptic_sim.experiments import thesis
 from haptic_sim.experiments.observer_gain import gain_at
 from haptic_sim.experiments.plan import CH7_CONTROLLERS, CH7_WALLS
-from haptic_sim.experiments.tables import fmt
 from haptic_sim.slide.session import SessionConfig, run_session
 from haptic_sim.slide.stability import law_for
 
 SEEDS = (0, 1, 2)
 DURATION_S = 40.0  # chapter 7's sessions
-within = thesis.within
 
 
 @dataclass(frozen=True)
@@ -37,12 +34,6 @@ class SeedCell:
     wall: float
     bandwidth_hz: float | None
     below_first_bin: bool = False
-
-    @property
-    def matches(self) -> bool:
-        """Within 15 % of the thesis's bandwidth (never for a band below the first bin)."""
-        bw = None if self.below_first_bin else self.bandwidth_hz
-        return within(self.mode, self.kf, self.wall, bw)
 
 
 def chapter7_session(
@@ -95,11 +86,6 @@ def seed_cells(base: SessionConfig, executor: Executor | None = None) -> list[Se
     return list(executor.map(_run, planned)) if executor else [_run(c) for c in planned]
 
 
-def shown(c: SeedCell) -> str:
-    """A cell's bandwidth as the tables show it: ``< 0.25`` below the first bin."""
-    return ("< " if c.below_first_bin else "") + fmt(c.bandwidth_hz)
-
-
 def median_bandwidth(cells: list[SeedCell]) -> float | None:
     """The median over the seeds of one cell's bandwidth (Hz); None if a seed has none, or if
     the median falls on a band below the first bin (a floor, not a value)."""
@@ -116,52 +102,3 @@ def medians(cells: list[SeedCell]) -> dict[tuple[str, float, float], float | Non
     """Each cell's median over the seeds (Hz; None: see ``median_bandwidth``)."""
     keys = dict.fromkeys((c.mode, c.kf, c.wall) for c in cells)
     return {k: median_bandwidth([c for c in cells if (c.mode, c.kf, c.wall) == k]) for k in keys}
-
-
-def spread_table(cells: list[SeedCell]) -> str:
-    """Each cell's bandwidth per seed and their median beside the thesis's, and the counts
-    within 15 % per seed and for the median."""
-    if not cells:
-        return ""
-    seeds = sorted({c.seed for c in cells})
-    by = {(c.mode, c.kf, c.wall, c.seed): c for c in cells}
-    med = medians(cells)
-    lines = [
-        f"**Table 7.1 for {len(seeds)} seeds of the hand** (batch; seed 0 is chapter 7's "
-        "table): bandwidth (Hz) per seed and their median, `*` within 15 % of the thesis, "
-        "`<` a band that ends below the first frequency bin:",
-        "",
-        "| cell | " + " | ".join(f"seed {s}" for s in seeds) + " | median | thesis |",
-        "|---|" + "---|" * (len(seeds) + 2),
-    ]
-    for mode, kf in CH7_CONTROLLERS:
-        for wall in CH7_WALLS:
-            row = [by.get((mode, kf, wall, s)) for s in seeds]
-            cols = ["-" if c is None else shown(c) + ("*" if c.matches else "") for c in row]
-            m = med.get((mode, kf, wall))
-            below = [c for c in row if c is not None and c.below_first_bin]
-            floor = "< " + fmt(below[0].bandwidth_hz) if below else "-"
-            cols.append(floor if m is None else fmt(m) + ("*" if within(mode, kf, wall, m) else ""))
-            name = mode if mode == "OL" else f"{mode} Kf={kf:g}"
-            ref = thesis.cell(mode, kf, wall)[0]
-            lines.append(f"| {name}, {wall:g} N/m | " + " | ".join(cols) + f" | {fmt(ref, 'g')} |")
-    n = counts(cells)
-    total = sum(1 for c in cells if c.seed == seeds[0])
-    lines.append(
-        "| within 15 % | "
-        + " | ".join(f"{n[s]} of {total}" for s in seeds)
-        + f" | {median_count(cells)} of {total} | |"
-    )
-    return "\n".join(lines) + "\n"
-
-
-def counts(cells: list[SeedCell]) -> dict[int, int]:
-    """Cells within 15 % of the thesis per seed."""
-    return {
-        s: sum(c.matches for c in cells if c.seed == s) for s in sorted({c.seed for c in cells})
-    }
-
-
-def median_count(cells: list[SeedCell]) -> int:
-    """Cells whose median over the seeds is within 15 % of the thesis."""
-    return sum(within(*k, m) for k, m in medians(cells).items())

@@ -3,7 +3,7 @@ cells' own numbers (``sweeps``)."""
 
 from __future__ import annotations
 
-from haptic_sim.experiments import spread, thesis
+from haptic_sim.experiments import spread_report, thesis
 from haptic_sim.experiments.records import Check
 from haptic_sim.experiments.results import TABLE_TARGET
 from haptic_sim.experiments.sweeps import (
@@ -83,7 +83,7 @@ def _matching(cells: list[SweepCell], ref: float | None) -> str:
     good = [
         f"{c.value:g}"
         for c in cells
-        if not c.below_first_bin and spread.within(c.mode, c.kf, c.wall, c.bandwidth_hz)
+        if not c.below_first_bin and spread_report.within(c.mode, c.kf, c.wall, c.bandwidth_hz)
     ]
     return ", ".join(good) or "none of the sweep's values"
 
@@ -252,12 +252,12 @@ def differences(r: SweepStudy) -> list[str]:
             "observer explains that here."
         )
     if r.seeds:
-        n = spread.counts(r.seeds)
+        n = spread_report.counts(r.seeds)
         per_seed = sum(1 for c in r.seeds if c.seed == min(n))
         out.append(
             "- **Table 7.1 within 15 %, per seed of the hand:** "
             + ", ".join(f"seed {s}: {k}" for s, k in n.items())
-            + f"; their median: {spread.median_count(r.seeds)} of {per_seed} (the sweeps "
+            + f"; their median: {spread_report.median_count(r.seeds)} of {per_seed} (the sweeps "
             "section)."
         )
     return out
@@ -267,7 +267,7 @@ def checks(r: SweepStudy) -> list[Check]:
     """Table 7.1 within 15 % for each seed of the hand and for their median, against the aim."""
     if not r.seeds:
         return []
-    n = spread.counts(r.seeds)
+    n = spread_report.counts(r.seeds)
     total = sum(1 for c in r.seeds if c.seed == min(n))
     out = [
         Check(
@@ -277,7 +277,7 @@ def checks(r: SweepStudy) -> list[Check]:
         )
         for s, k in n.items()
     ]
-    m = spread.median_count(r.seeds)
+    m = spread_report.median_count(r.seeds)
     out.append(
         Check(
             f"Table 7.1, the median of {len(n)} seeds of the hand: {m} of {total} cells within "

@@ -2,9 +2,10 @@
 
 The thesis's numbers live in ``haptic_sim.experiments.thesis`` and nowhere else. What chooses a
 parameter (the configuration's loading, the hand's depth rule, the observer-gain rule, the plan
-of the chapter-6 and chapter-7 runs, the batch sessions of the seeds and the sweeps) must work
-with that module unimportable, and give the same parameters as with it; the report's tables
-alone set the measurements beside the thesis's.
+of the chapter-6 and chapter-7 runs, the batch sessions of the seeds and of every sweep) must
+work with that module unimportable, and give the same parameters as with it; the report's
+tables alone (``tables``, ``spread_report``, ``sweeps_report``...) set the measurements beside
+the thesis's.
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ CHOOSERS = (
     "haptic_sim.experiments.plan",
     "haptic_sim.experiments.graph_runs",
     "haptic_sim.experiments.identification",
+    "haptic_sim.experiments.spread",
+    "haptic_sim.experiments.sweeps",
 )
 
 #: builds every parameter set the reproduction runs from and prints it as JSON; ``BLOCK`` makes
@@ -38,7 +41,7 @@ import json, sys
 if BLOCK:
     sys.modules[%(thesis)r] = None  # any import of it now raises ImportError
 from pathlib import Path
-from haptic_sim.experiments import observer_gain, plan
+from haptic_sim.experiments import observer_gain, plan, spread, sweeps
 from haptic_sim.hand import depth_reference
 from haptic_sim.slide.session import SessionConfig
 config = Path(%(config)r)
@@ -50,6 +53,9 @@ print(json.dumps({
     "runs": {r.name: r.params for r in runs},
     "gains": {str(kf): observer_gain.gain_at(kf, base) for kf in (1.0, 2.0, 25.0, 100.0)},
     "hand": [ref.offset_m, ref.amplitude_m],
+    "seeds": [repr(c.config) for c in spread.cells(base)],
+    "sweeps": [repr(s.config(base, m, kf, w, v)) for s in sweeps.SWEEPS for m, kf in s.controllers
+               for w in s.walls for v in s.values_for(base, kf)],
     "config": repr(base),
     "thesis_loaded": %(thesis)r in sys.modules and sys.modules[%(thesis)r] is not None,
 }, sort_keys=True, default=str))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from haptic_sim.experiments import spread, sweeps, sweeps_report
+from haptic_sim.experiments import spread, spread_report, sweeps, sweeps_report
 from haptic_sim.experiments.sweeps import (
     DEPTH,
     FRICTION,
@@ -135,7 +135,7 @@ def test_the_tables_and_the_text_come_from_the_cells() -> None:
         "close to the frictional force" in d and "OL < 0.25 Hz (coherence 0.09)" in d for d in diffs
     )
     assert any("seed 0: 1, seed 1: 1, seed 2: 0; their median: 1 of 1" in d for d in diffs)
-    table = spread.spread_table(r.seeds)
+    table = spread_report.spread_table(r.seeds)
     assert "| OL, 800 N/m | 3.86* | 4.07* | < 0.25 | 3.86* | 3.8 |" in table
     assert "| within 15 % | 1 of 1 | 1 of 1 | 0 of 1 | 1 of 1 | |" in table
     checks = sweeps_report.checks(r)
@@ -153,6 +153,6 @@ def test_the_median_of_the_seeds_is_no_value_where_it_falls_below_the_first_bin(
         for s, bw in ((0, 0.25), (1, 0.25), (2, 0.6))
     ]
     assert spread.median_bandwidth(cells) is None  # "< 0.25" is a floor, not 0.25 Hz
-    assert spread.median_count(cells) == 0
+    assert spread_report.median_count(cells) == 0
     cells[1] = spread.SeedCell(1, "OL", 0.0, 2400.0, 0.62)
-    assert spread.median_bandwidth(cells) == 0.6 and spread.median_count(cells) == 1
+    assert spread.median_bandwidth(cells) == 0.6 and spread_report.median_count(cells) == 1
