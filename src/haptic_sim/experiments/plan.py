@@ -6,7 +6,8 @@ cell, so every controller meets the same hand). The hand pushes to the configura
 at every wall (``haptic_sim.hand.depth_reference``); DOB takes the observer gain of its Kf
 (``observer_gain.gain_at``). OL and CL runs leave the observer out (they do not use it) and the
 controller subscribes only to its own mode's input; the recorder records what the analysis reads.
-The quick variant (the demo) runs OL, CL Kf = 2 and DOB Kf = 1 at 800 N/m for 20 s.
+The quick variant (the demo) runs OL, CL Kf = 2 and DOB Kf = 1 at 800 N/m, 40 s each (as
+chapter 7: the 4 s spectral segments need the whole session's averages).
 
 Chapter 6 (vibration onset, through the graph), the thesis's user trying to provoke vibration:
 a light 20 N/m grip pushing 1 N into the wall, 4-4.5 s per wall, in two protocols of
@@ -34,7 +35,7 @@ CH7_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.
 CH7_WALLS: list[float] = [80.0, 800.0, 1600.0, 2400.0]
 QUICK_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0)]
 QUICK_WALLS: list[float] = [800.0]
-QUICK_DURATION_S = 20.0
+QUICK_DURATION_S = 40.0
 CH6_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 100.0)]
 #: the linear protocol: the thesis's walls (800-3200 N/m) and points around the OL and CL bounds
 #: (2544, 848 N/m); DOB at two (unstable at every wall)
