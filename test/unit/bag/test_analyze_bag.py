@@ -270,31 +270,3 @@ def test_a_vibration_burst_is_found_window_by_window() -> None:
     assert osc.frequency_hz == 14.0 and osc.amplitude_m == pytest.approx(5e-4, rel=0.1)
     quiet = analyze_arrays(x[:20_000], f[:20_000], v[:20_000], FS, K, penetration=x[:20_000])
     assert quiet.oscillation is not None and not quiet.oscillation.vibrating
-
-
-def test_a_push_and_hold_bag_shorter_than_a_spectral_segment_gives_its_pulse_response(
-    tmp_path: Path,
-) -> None:
-    """Chapter 6's linear protocol (4 s; 3 s after the ramp-in, under one 4 s transparency
-    segment): no transparency, but the pulse response is what the bag is for, so it is analysed
-    (a decaying response at 800 N/m OL, friction off)."""
-    from haptic_sim.slide.stability import StabilityProtocol
-
-    protocol = StabilityProtocol()
-    cfg = protocol.session(SessionConfig(), 800.0)
-    res = run_session(cfg)
-    h = cfg.hand
-    params = session_params("OL", 0.0, 800.0)
-    params["device_node"] = {
-        "hand.behaviour": h.behaviour,
-        "hand.stiffness_n_per_m": h.stiffness_n_per_m,
-        "hand.offset_m": h.offset_m,
-        "hand.perturbation_n": h.perturbation_n,
-        "hand.perturbation_at_s": h.perturbation_at_s,
-        "hand.perturbation_s": h.perturbation_s,
-    }
-    bag = tmp_path / "pulse"
-    write_session_bag(bag, res.q, res.force_measured, FS, params, velocity=res.qd)
-    (seg,) = analyze_bag(bag).segments
-    assert seg.figures.transparency is None and "too short" in (seg.figures.problem or "")
-    assert seg.perturbation is not None and seg.perturbation.growth_per_s < 0.0

@@ -128,7 +128,7 @@ def test_segment_too_short_for_the_spectral_settings(tmp_path: Path, capsys) -> 
     bag = tmp_path / "short"
     write_session_bag(bag, x, f, FS, session_params(), velocity=v)
     assert error_of([str(bag)], capsys) == (
-        f"ERROR: {bag}: segment too short for the spectral settings: 1.8 s < one 4 s segment "
+        f"ERROR: {bag}: segment too short for the spectral settings: 1.8 s < one 2 s segment "
         "(1.8 s analysed after leaving out 0.6 s)"
     )
 
