@@ -48,8 +48,10 @@ lint: $(STAMP)
 	@$(BIN)/ruff format --check src test scripts
 	@$(BIN)/mypy
 
+# Measure BENCHMARKS.md's marked tables on this machine and rewrite their rows in place
+# (BENCH_ARGS: --only NAME..., --note TEXT, --print; scripts/bench_tables.py --help)
 bench: $(STAMP)
-	@$(BIN)/python scripts/benchmarks.py
+	@$(BIN)/python scripts/bench_tables.py $(BENCH_ARGS)
 
 # Re-resolve the dependency set and rewrite constraints.txt (review the diff).
 lock:

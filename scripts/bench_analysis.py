@@ -35,6 +35,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 ANALYZE = Path(sys.executable).parent / "haptic-analyze"
 BAGS = {"40s": 1, "1h": 90}  # name -> how many 40 s sessions back to back
+DEFAULT_DIR = Path(tempfile.gettempdir()) / "haptic_dob_bench_bags"  # where the bags are kept
 
 
 def make_bag(directory: Path, name: str, storage: str) -> Path:
@@ -92,11 +93,27 @@ def run_once(bag: Path) -> tuple[float, float]:
     return wall, usage.ru_maxrss / 1024.0
 
 
+def bench_bag(name: str, storage: str, runs: int | None = None) -> str:
+    """One line for ``benchmarks.py --tables``: the named bag (in the default ``--dir``) through
+    ``haptic-analyze``, median wall time and peak resident memory."""
+    DEFAULT_DIR.mkdir(parents=True, exist_ok=True)
+    bag = make_bag(DEFAULT_DIR, name, storage)
+    n = runs or (5 if name == "40s" else 3)
+    samples = [run_once(bag) for _ in range(n)]
+    walls, rss = [w for w, _ in samples], [r for _, r in samples]
+    size = sum(f.stat().st_size for f in bag.iterdir()) / 1e6
+    return (
+        f"median {statistics.median(walls):.2f} s of {n} (runs: "
+        f"{', '.join(f'{w:.2f}' for w in walls)}), peak RSS {statistics.median(rss):.0f} MB; "
+        f"the bag {size:.0f} MB"
+    )
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument(
         "--dir",
-        default=str(Path(tempfile.gettempdir()) / "haptic_dob_bench_bags"),
+        default=str(DEFAULT_DIR),
         help="where the bags are kept (default: haptic_dob_bench_bags in the temp directory)",
     )
     p.add_argument("--only", choices=sorted(BAGS), help="one bag only")

@@ -10,7 +10,7 @@ import time
 
 
 def bench_batch_session(repeat: int) -> str:
-    """A 40 s slide session at 1 kHz (default config, OL and DOB): real-time factor."""
+    """A 40 s slide session at 1 kHz (default config, OL and DOB): real-time factor, cycle."""
     from haptic_sim.slide.session import SessionConfig, run_session
     from haptic_sim.slide.stability import law_for
 
@@ -23,7 +23,10 @@ def bench_batch_session(repeat: int) -> str:
             run_session(cfg)
             times.append(time.perf_counter() - t0)
         med = statistics.median(times)
-        out.append(f"{mode}: median {med:.3f} s for 40 s simulated -> {40.0 / med:.1f}x real time")
+        out.append(
+            f"{mode}: median {med:.3f} s for 40 s simulated -> {40.0 / med:.1f}x real time, "
+            f"{med / 40.0 * 1e3:.1f} us a cycle"
+        )
     return "; ".join(out)
 
 

@@ -3,7 +3,8 @@
 Each run is a fresh ``haptic-launch`` on a random ``ROS_DOMAIN_ID`` (localhost only), 20 s at
 1 kHz, laid out by default (the loop's four nodes in one process), ``--composed`` or
 ``--processes``; ``GRAPH_ARGS`` adds the command line's ``--set``, ``--rt-priority``, ``--pin``
-and ``--cpu-latency``.
+and ``--cpu-latency``. Each run's cycle (lockstep) or median latency (real time) is also given
+against the batch cycle and one raw hop measured just before and after it (``bench_floors``).
 """
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ import statistics
 import subprocess
 import sys
 import tempfile
+
+from bench_floors import around, summary
 
 #: extra ``haptic-launch`` arguments of the graph benchmarks (--set, --rt-priority, --pin,
 #: --cpu-latency); ``benchmarks.py`` fills it from its command line
@@ -60,11 +63,15 @@ def lockstep_cycle_us(extra: list[str], seconds: float = 20.0) -> float:
 
 
 def _lockstep(repeat: int, extra: list[str]) -> str:
-    rtf = [real_time_factor(extra) for _ in range(repeat)]
-    per_cycle_us = 1e3 / statistics.median(rtf)
+    runs = [around(lambda: real_time_factor(extra), GRAPH_ARGS) for _ in range(repeat)]
+    rtf = [r for r, _ in runs]
+    batch = statistics.median(1e3 / r / f.batch_us for r, f in runs)
+    hop = statistics.median(1e3 / r / f.hop_us for r, f in runs)
     return (
         f"real-time factor median {statistics.median(rtf):.2f} (runs: "
-        f"{', '.join(f'{r:.2f}' for r in sorted(rtf))}) -> {per_cycle_us:.0f} us per cycle"
+        f"{', '.join(f'{r:.2f}' for r in rtf)}) -> {1e3 / statistics.median(rtf):.0f} us a "
+        f"cycle, {batch:.2f}x the batch cycle, {hop:.2f}x one hop (medians of the runs' ratios; "
+        f"{summary([f for _, f in runs])})"
     )
 
 
@@ -84,32 +91,40 @@ def bench_lockstep_processes(repeat: int) -> str:
     return _lockstep(repeat, ["--processes"])
 
 
+def _realtime_run(extra: list[str]) -> dict[str, float]:
+    """One real-time graph run of 20 s: the device's statistics (``stats_file``)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        stats = os.path.join(tmp, "stats.json")
+        launch_graph(
+            graph_args(extra),
+            [
+                "device_node:clock_mode=realtime",
+                "device_node:duration_s=20.0",
+                f"device_node:stats_file={stats}",
+            ],
+            300,
+        )
+        with open(stats, encoding="utf-8") as fh:
+            result: dict[str, float] = json.load(fh)
+            return result
+
+
 def _realtime(repeat: int, extra: list[str]) -> str:
-    rows = []
-    for _ in range(repeat):
-        with tempfile.TemporaryDirectory() as tmp:
-            stats = os.path.join(tmp, "stats.json")
-            launch_graph(
-                graph_args(extra),
-                [
-                    "device_node:clock_mode=realtime",
-                    "device_node:duration_s=20.0",
-                    f"device_node:stats_file={stats}",
-                ],
-                300,
-            )
-            with open(stats, encoding="utf-8") as fh:
-                rows.append(json.load(fh))
+    runs = [around(lambda: _realtime_run(extra), GRAPH_ARGS) for _ in range(repeat)]
+    rows = [r for r, _ in runs]
     med = {
         k: statistics.median(r[k] for r in rows)
         for k in ("on_time_pct", "latency_p50_ms", "latency_p99_ms", "missed_ticks")
     }
-    runs = ", ".join(f"{r['on_time_pct']:.2f}" for r in rows)
+    batch = statistics.median(r["latency_p50_ms"] * 1e3 / f.batch_us for r, f in runs)
+    hop = statistics.median(r["latency_p50_ms"] * 1e3 / f.hop_us for r, f in runs)
+    on_time = ", ".join(f"{r['on_time_pct']:.2f}" for r in rows)
     return (
         f"commands before the next tick: median {med['on_time_pct']:.2f} % (runs: "
-        f"{runs}); sample-to-command latency "
-        f"p50 {med['latency_p50_ms']:.3f} ms, p99 {med['latency_p99_ms']:.3f} ms; "
-        f"missed ticks {med['missed_ticks']:g} of 20000"
+        f"{on_time}); sample-to-command latency p50 {med['latency_p50_ms']:.3f} ms "
+        f"({batch:.2f}x the batch cycle, {hop:.2f}x one hop), p99 "
+        f"{med['latency_p99_ms']:.3f} ms; missed ticks {med['missed_ticks']:g} of 20000 "
+        f"({summary([f for _, f in runs])})"
     )
 
 

@@ -1,7 +1,8 @@
 """Benchmarks of the suite (not timed tests): each prints medians over repeated runs.
 
 Usage: ``.venv/bin/python scripts/benchmarks.py [NAME ...] [--repeat N]``; without names, all
-in-process benchmarks run. BENCHMARKS.md records the figures with the exact command and machine.
+run, one line each. ``make bench`` (``bench_tables.py``) runs them as BENCHMARKS.md's rows give
+them and rewrites those rows with the figures, the machine and the date.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from pathlib import Path
 # bench_timer_floor (the machine's own stalls), bench_margin (the graph against its floors)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_batch import bench_batch_session, bench_observer_update
+from bench_bridge import bench_bridge
 from bench_graph import (
     GRAPH_ARGS,
     bench_lockstep,
@@ -63,6 +65,7 @@ BENCHMARKS: dict[str, Callable[[int], str]] = {
     "margin": bench_margin,
     "realtime-margin": bench_realtime_margin,
     "log": bench_log,
+    "bridge": bench_bridge,
 }
 
 

@@ -14,6 +14,7 @@ OUT = Path(__file__).resolve().parents[1] / "docs" / "parameters.md"
 
 def tables() -> list[tuple[str, str, list]]:
     """(node, ros2 run name, specs) of every node."""
+    from haptic_dob.nodes.bridge_node import bridge_node_specs
     from haptic_dob.nodes.channel_node import channel_node_specs
     from haptic_dob.nodes.controller_node import controller_node_specs
     from haptic_dob.nodes.environment_node import environment_node_specs
@@ -32,6 +33,7 @@ def tables() -> list[tuple[str, str, list]]:
             "haptic_dob slave_controller_node",
             slave_controller_node_specs(),
         ),
+        ("bridge_node", "haptic_dob bridge_node", bridge_node_specs()),
     ]
     try:
         from haptic_dob.nodes.recorder_node import recorder_specs

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from haptic_msgs_py import cdr, wire
-from haptic_msgs_py.stamps import NS_PER_S, command_label, command_stamp
+from haptic_msgs_py.stamps import NS_PER_S, command_label, command_parts
 from haptic_msgs_py.values import EffortCommand, JointSample, Stamp, StampedVector
 
 Encoder = Callable[[Any], bytes]
@@ -126,7 +126,7 @@ JOINT_STATE = Codec("sensor_msgs/msg/JointState", _joint_encoder, _joint_decoder
 
 def _command_encoder(_frame_id: str) -> Encoder:
     def encode(value: EffortCommand) -> bytes:
-        label = "" if value.stamp_ns is None else command_label(value.stamp_ns)
+        label = "" if value.stamp_ns is None else command_label(value.stamp_ns, value.token)
         return cdr.pack_multi_array(label, value.effort)
 
     return encode
@@ -139,13 +139,17 @@ def _command_decode(data: bytes | memoryview) -> EffortCommand:
     fast = cdr.read_multi_array(data)
     if fast is not None:
         label, values = fast
-        return EffortCommand(None if label is None else command_stamp(label), values)
-    m = _decode_multi_array(data)
-    dims = m.layout.dim
-    return EffortCommand(command_stamp(dims[0].label) if dims else None, _floats(m.data))
+    else:
+        m = _decode_multi_array(data)
+        label, values = (m.layout.dim[0].label if m.layout.dim else None), _floats(m.data)
+    if label is None:
+        return EffortCommand(None, values)
+    stamp, token = command_parts(label)
+    return EffortCommand(stamp, values, token)
 
 
-#: ``std_msgs/Float64MultiArray`` in joint order, the cycle named in the first label
+#: ``std_msgs/Float64MultiArray`` in joint order, the cycle (and the sender's token) named in the
+#: first label
 EFFORT = Codec("std_msgs/msg/Float64MultiArray", _command_encoder, lambda: _command_decode)
 
 

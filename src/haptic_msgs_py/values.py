@@ -8,7 +8,7 @@ Being immutable, a value can wait in the outgoing queue while its publisher move
   wrenches (WrenchStamped force);
 - ``JointSample``: joint_states, effort_estimate (sensor_msgs/JointState);
 - ``EffortCommand``: effort_command (std_msgs/Float64MultiArray, its cycle in the layout label
-  ``effort@<stamp_ns>``);
+  ``effort@<stamp_ns>``, its sender's token after a ``#``);
 - ``Stamp``: /clock (rosgraph_msgs/Clock).
 """
 
@@ -37,10 +37,12 @@ class JointSample(NamedTuple):
 
 
 class EffortCommand(NamedTuple):
-    """Joint efforts (N or N m) in joint order, for cycle ``stamp_ns`` (None: the newest)."""
+    """Joint efforts (N or N m) in joint order, for cycle ``stamp_ns`` (None: the newest), with
+    its sender's command token ('' when it has none)."""
 
     stamp_ns: int | None
     effort: tuple[float, ...]
+    token: str = ""
 
 
 class Stamp(NamedTuple):

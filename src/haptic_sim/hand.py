@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -38,6 +39,15 @@ from haptic_dob.runtime.params import param
 BEHAVIOURS = ("semi_random", "push_hold", "none")
 BLOCK_S = 0.1  # s of reference per generated block (numpy, 1000 physics steps at 10 kHz)
 Block = tuple[np.ndarray, np.ndarray, np.ndarray]  # position (m), velocity (m/s), force (N)
+
+
+class Reference(Protocol):
+    """What a 1-D plant asks its hand's reference for (``HandReference``, one axis of a 3-D
+    one)."""
+
+    def arrays(self, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]: ...
+
+    def prepare(self, i: int) -> None: ...
 
 
 @dataclass(frozen=True)

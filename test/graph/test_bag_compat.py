@@ -1,12 +1,10 @@
 """The recorder's bags are rosbag2 Jazzy bags: ``ros2 bag info`` / ``play`` can read them.
 
 There is no rosbag2 here, so the checks are against what rosbag2 Jazzy reads, taken from its
-sources (ros2/rosbag2, branch jazzy): the fields ``rosbag2_storage/yaml.hpp`` decodes from a
-version-9 ``metadata.yaml``, what ``rosbag2_storage_mcap/src/mcap_storage.cpp`` reads from an MCAP
-file (the ``ros2`` profile, the statistics record, the ``rosbag2`` metadata record, each channel's
-``offered_qos_profiles``), read with an independent MCAP reader (``mcap``, Foxglove's, checking
-every CRC), and the tables ``rosbag2_storage_sqlite3/src/.../sqlite_storage.cpp`` creates (schema
-version 4). A killed recording's recovered bag passes the same checks.
+sources (``support.jazzy_bag``): the metadata, the MCAP records, the sqlite3 tables, the
+distribution (``jazzy``) and each topic's offered QoS profiles as ``ros2 bag record`` stores
+them and ``ros2 bag play`` offers them again. A killed recording's recovered bag passes the same
+checks.
 
 The other way: bags as ``ros2 bag record`` writes them (``ros2bag``: MCAP uncompressed and with
 zstd chunks, sqlite3; ``ros2msg`` schemas, receive times, the type hashes) go through
@@ -15,66 +13,60 @@ zstd chunks, sqlite3; ``ros2msg`` schemas, receive times, the type hashes) go th
 
 from __future__ import annotations
 
-import sqlite3
 from pathlib import Path
 from typing import Any
 
 import pytest
-import yaml
+from rosbags.interfaces import (
+    Qos,
+    QosDurability,
+    QosHistory,
+    QosLiveliness,
+    QosReliability,
+    QosTime,
+)
 
 from haptic_dob.bag.recover import recover
 from haptic_dob.recorder.recording import Recording
 from haptic_dob.recorder.topics import PARAMETER_EVENT_TYPE
 from haptic_msgs_py import wire
 from haptic_msgs_py.topics import EE_POSE, JOINT_STATES, SESSION_TOPICS
+from support.jazzy_bag import check_bag, offered
 
 MS = 1_000_000
 N = 1500  # samples per topic: more than one second, so the recorder made the bag durable once
 
-# rosbag2 (jazzy) yaml.hpp: convert<BagMetadata>::decode for version 9, and its parts
-BAG_FIELDS: dict[str, Any] = {
-    "version": int,
-    "storage_identifier": str,
-    "duration": dict,
-    "starting_time": dict,
-    "message_count": int,
-    "topics_with_message_count": list,
-    "relative_file_paths": list,
-    "compression_format": str,
-    "compression_mode": str,
-    "files": list,
-    "custom_data": (dict, type(None)),  # an empty map is written as null (~), by rosbag2 too
-    "ros_distro": str,
+INFINITE = QosTime(9223372036, 854775807)  # rmw's infinite duration, as the graph reports it
+# what the graph reports of a publisher (rmw_fastrtps: no history or depth), as qos.cpp writes it
+REPORTED_LOOP = {
+    "history": "unknown",
+    "depth": 0,
+    "reliability": "reliable",
+    "durability": "volatile",
+    "deadline": {"sec": 9223372036, "nsec": 854775807},
+    "lifespan": {"sec": 9223372036, "nsec": 854775807},
+    "liveliness": "automatic",
+    "liveliness_lease_duration": {"sec": 9223372036, "nsec": 854775807},
+    "avoid_ros_namespace_conventions": False,
 }
-TOPIC_FIELDS = {
-    "name": str,
-    "type": str,
-    "serialization_format": str,
-    "offered_qos_profiles": list,  # version >= 9: a sequence of QoS maps
-    "type_description_hash": str,
-}
-FILE_FIELDS = {"path": str, "starting_time": dict, "duration": dict, "message_count": int}
 
-# rosbag2 (jazzy) sqlite_storage.cpp: SqliteStorage::initialize, kDBSchemaVersion_ = 4
-SQLITE_TABLES = {
-    "schema": ["schema_version", "ros_distro"],
-    "metadata": ["id", "metadata_version", "metadata"],
-    "topics": [
-        "id",
-        "name",
-        "type",
-        "serialization_format",
-        "offered_qos_profiles",
-        "type_description_hash",
+
+def reported(reliability: QosReliability, durability: QosDurability, depth: int = 0) -> Qos:
+    history = QosHistory.KEEP_LAST if depth else QosHistory.UNKNOWN
+    return Qos(
+        history, depth, reliability, durability, INFINITE, INFINITE,
+        QosLiveliness.AUTOMATIC, INFINITE, False,
+    )  # fmt: skip
+
+
+#: the publishers of each topic of ``recorded``: the pose has two that differ
+OFFERED = {
+    "/joint_states": [reported(QosReliability.RELIABLE, QosDurability.VOLATILE)],
+    "/ee_pose": [
+        reported(QosReliability.BEST_EFFORT, QosDurability.VOLATILE),
+        reported(QosReliability.RELIABLE, QosDurability.TRANSIENT_LOCAL, depth=7),
     ],
-    "message_definitions": [
-        "id",
-        "topic_type",
-        "encoding",
-        "encoded_message_definition",
-        "type_description_hash",
-    ],
-    "messages": ["id", "topic_id", "timestamp", "data"],
+    "/parameter_events": [],  # none seen
 }
 
 
@@ -82,8 +74,8 @@ def recorded(path: Path, storage: str) -> Path:
     """A bag written the way ``recorder_node`` writes one: joint states and poses at 1 kHz
     stamps, logged at their stamps (each pose comes after the next joint state, so the log times
     go back in the file), a parameter snapshot on ``/parameter_events``, closed with its
-    counts."""
-    rec = Recording(path, storage, MS)
+    counts; each topic with the QoS profiles its publishers offered (``OFFERED``)."""
+    rec = Recording(path, storage, MS, offered=lambda topic: OFFERED[topic])
     on_js = rec.add_topic("/joint_states", SESSION_TOPICS[JOINT_STATES], loop=True)
     on_pose = rec.add_topic("/ee_pose", SESSION_TOPICS[EE_POSE], loop=True)
     rec.add_topic("/parameter_events", PARAMETER_EVENT_TYPE)
@@ -99,86 +91,27 @@ def recorded(path: Path, storage: str) -> Path:
     return path
 
 
-def check_fields(node: dict[str, Any], fields: dict[str, Any], where: str) -> None:
-    for key, kind in fields.items():
-        assert key in node, f"{where}: no {key}"
-        assert isinstance(node[key], kind), f"{where}.{key}: {node[key]!r} is not {kind}"
+def check_offered(bag: Path, meta: dict[str, Any]) -> None:
+    """The offered QoS of ``OFFERED``, as rosbag2 writes it and as rosbags reads it back."""
+    from rosbags.rosbag2 import Reader
 
-
-def check_metadata(doc: dict[str, Any], storage: str) -> dict[str, Any]:
-    """The version-9 bag metadata rosbag2 Jazzy decodes; returns it."""
-    meta = doc["rosbag2_bagfile_information"]
-    check_fields(meta, BAG_FIELDS, "metadata")
-    assert meta["version"] == 9 and meta["storage_identifier"] == storage
-    assert "nanoseconds" in meta["duration"]
-    assert "nanoseconds_since_epoch" in meta["starting_time"]
-    for i, t in enumerate(meta["topics_with_message_count"]):
-        check_fields(t["topic_metadata"], TOPIC_FIELDS, f"topics[{i}]")
-        assert t["topic_metadata"]["serialization_format"] == "cdr"
-        assert isinstance(t["message_count"], int)
-    for i, f in enumerate(meta["files"]):
-        check_fields(f, FILE_FIELDS, f"files[{i}]")
-    assert all(isinstance(v, str) for v in (meta["custom_data"] or {}).values())
-    total = sum(t["message_count"] for t in meta["topics_with_message_count"])
-    assert meta["message_count"] == total == sum(f["message_count"] for f in meta["files"])
-    return meta
-
-
-def check_mcap(path: Path, meta: dict[str, Any], in_order: bool = True) -> None:
-    """What rosbag2's MCAP plugin reads, through an independent reader that checks CRCs;
-    ``in_order``: also read every message in log-time order (slow for a large bag)."""
-    from mcap.reader import make_reader
-
-    with path.open("rb") as fh:
-        reader = make_reader(fh, validate_crcs=True)
-        assert reader.get_header().profile == "ros2"
-        summary = reader.get_summary()
-        assert summary is not None and summary.statistics is not None
-        assert summary.statistics.message_count == meta["message_count"]
-        schemas = summary.schemas
-        for channel in summary.channels.values():
-            assert channel.message_encoding == "cdr"
-            assert schemas[channel.schema_id].encoding == "ros2msg"
-            assert isinstance(yaml.safe_load(channel.metadata["offered_qos_profiles"]), list)
-        (record,) = [m for m in reader.iter_metadata() if m.name == "rosbag2"]
-        # decoded as a BagMetadata node itself (no rosbag2_bagfile_information key)
-        assert yaml.safe_load(record.metadata["serialized_metadata"]) == meta
-        times = [m.log_time for _, _, m in reader.iter_messages(log_time_order=in_order)]
-    assert len(times) == meta["message_count"]
-    assert times == sorted(times) or not in_order
-
-
-def check_sqlite(path: Path, meta: dict[str, Any]) -> None:
-    """The tables and columns rosbag2's sqlite3 plugin creates and reads (schema version 4)."""
-    db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
-    try:
-        for table, columns in SQLITE_TABLES.items():
-            got = [row[1] for row in db.execute(f"PRAGMA table_info({table})")]
-            assert got == columns, table
-        ((version,),) = db.execute("SELECT schema_version FROM schema").fetchall()
-        assert version == 4
-        ((meta_version, text),) = db.execute("SELECT metadata_version, metadata FROM metadata")
-        assert meta_version == 9 and yaml.safe_load(text) == meta  # a BagMetadata node itself
-        for (qos,) in db.execute("SELECT offered_qos_profiles FROM topics"):
-            assert isinstance(yaml.safe_load(qos), list)
-        ((count,),) = db.execute("SELECT count(*) FROM messages")
-        assert count == meta["message_count"]
-    finally:
-        db.close()
-
-
-def check_bag(bag: Path, storage: str, in_order: bool = True) -> None:
-    meta = check_metadata(yaml.safe_load((bag / "metadata.yaml").read_text()), storage)
-    (name,) = meta["relative_file_paths"]
-    if storage == "mcap":
-        check_mcap(bag / name, meta, in_order)
-    else:
-        check_sqlite(bag / name, meta)
+    got = offered(meta)
+    assert got["/joint_states"] == [REPORTED_LOOP]
+    assert [q["reliability"] for q in got["/ee_pose"]] == ["best_effort", "reliable"]
+    assert [q["durability"] for q in got["/ee_pose"]] == ["volatile", "transient_local"]
+    assert [(q["history"], q["depth"]) for q in got["/ee_pose"]] == [
+        ("unknown", 0),
+        ("keep_last", 7),
+    ]
+    assert got["/parameter_events"] == []
+    with Reader(bag) as reader:
+        assert {c.topic: c.ext.offered_qos_profiles for c in reader.connections} == OFFERED
 
 
 @pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
 def test_the_recorders_bag_is_what_rosbag2_jazzy_reads(tmp_path: Path, storage: str) -> None:
-    check_bag(recorded(tmp_path / "session", storage), storage)
+    bag = recorded(tmp_path / "session", storage)
+    check_offered(bag, check_bag(bag, storage))
 
 
 @pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
@@ -187,7 +120,7 @@ def test_a_recovered_bag_is_what_rosbag2_jazzy_reads(tmp_path: Path, storage: st
     (bag / "metadata.yaml").unlink()  # as a kill leaves it (the data itself is complete here)
     got = recover(bag)
     assert got.messages == 2 * N + 1
-    check_bag(got.out, storage)
+    check_offered(got.out, check_bag(got.out, storage))
 
 
 ROS2_BAGS = [("mcap", "none"), ("mcap", "zstd_fast"), ("sqlite3", "none")]

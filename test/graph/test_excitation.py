@@ -89,3 +89,33 @@ def test_the_environment_node_takes_the_excitation_at_run_time(context) -> None:
         assert env.excitation.kind == "step"
     finally:
         env.destroy_node()
+
+
+def test_the_environment_node_takes_an_excitation_along_each_axis(context) -> None:
+    """A multisine per axis and a holding spring, set in one call; a step along the axes is
+    refused with the reason and changes nothing."""
+    from rclpy.parameter import Parameter
+
+    from haptic_dob.nodes.environment_node import EnvironmentNode
+
+    env = EnvironmentNode(context=context)
+    try:
+        ok = env.set_parameters_atomically(
+            [
+                Parameter("excitation.kind", value="multisine"),
+                Parameter("excitation.amplitude_n", value=1.0),
+                Parameter("excitation.along", value="axes"),
+                Parameter("excitation.hold_n_per_m", value=150.0),
+            ]
+        )
+        assert ok.successful, ok.reason
+        want = Excitation("multisine", 1.0, along="axes", hold_n_per_m=150.0)
+        assert env.excitation == want
+        assert env.excitation.force(3.0, (1.0, 0.0, 0.0), (0.0, 0.0, 0.0)) == want.force(
+            3.0, (1.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+        )
+        res = env.set_parameters([Parameter("excitation.kind", value="step")])[0]
+        assert not res.successful and "along axes needs a chirp or a multisine" in res.reason
+        assert env.excitation == want
+    finally:
+        env.destroy_node()

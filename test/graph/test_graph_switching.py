@@ -18,6 +18,7 @@ from haptic_msgs_py.topics import (
     WRENCH_MEASURED,
 )
 from support.rosgraph import Collector, isolated_env, launch, read_force, set_parameter, switch
+from support.waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
@@ -65,11 +66,27 @@ def test_switch_ol_dob_cl_takes_effect_on_the_next_cycle(root, tmp_path) -> None
     sets = [WAIT_FOR, "device_node:duration_s=0.0", "controller_node:kf=1.0"]
     graph = launch(str(root / "config" / "slide_sim.yaml"), env, sets, tmp_path / "launch.log")
     switched_at: dict[str, float] = {}
+    said: dict[str, str] = {}  # law -> the controller's line naming the old law's last cycle
+
+    def wait_said(law: str) -> None:
+        """The evidence is the controller's line: read it while the graph runs (bounded), not
+        from whatever of the output is left after the stop."""
+        pattern = re.compile(rf"law now {law}, .* after stamp_ns \d+")
+
+        def found() -> bool:
+            match = pattern.search(graph.output())
+            if match:
+                said[law] = match.group(0)
+            return match is not None
+
+        assert wait_until(found, 30, poll_s=0.1), graph.output()
+
     try:
         assert col.wait_for(EFFORT_COMMAND, 1500, 60), graph.output()
         ok, reason = switch(env, "DOB")
         switched_at["DOB"] = time.monotonic()
         assert ok, reason
+        wait_said("DOB")
         n = col.count(EFFORT_COMMAND)
         assert col.wait_for(EFFORT_COMMAND, n + 1000, 30)
         ok, reason = set_parameter(env, "controller_node", "kf", -1.0)
@@ -81,6 +98,7 @@ def test_switch_ol_dob_cl_takes_effect_on_the_next_cycle(root, tmp_path) -> None
         ok, reason = switch(env, "CL")
         switched_at["CL"] = time.monotonic()
         assert ok, reason
+        wait_said("CL")
         n = col.count(EFFORT_COMMAND)
         assert col.wait_for(EFFORT_COMMAND, n + 1000, 30)
     finally:
@@ -90,12 +108,7 @@ def test_switch_ol_dob_cl_takes_effect_on_the_next_cycle(root, tmp_path) -> None
     assert stamps == sorted(stamps)
     # the controller names the last cycle of the old law; from the next cycle on every command is
     # the new law's ("the next cycle")
-    log = graph.output()
-    last_old = {}
-    for law in switched_at:
-        match = re.search(rf"law now {law}, .* after stamp_ns (\d+)", log)
-        assert match, log
-        last_old[law] = int(match.group(1))
+    last_old = {law: int(said[law].rsplit(" ", 1)[1]) for law in switched_at}
     assert last_old["DOB"] < last_old["CL"]
 
     def law_at(k: int) -> str:

@@ -359,7 +359,7 @@ def test_a_graph_stopped_while_its_nodes_start_stops_quietly() -> None:
         (["device_node", "pilot_node"], 2, "ERROR: unknown node(s) pilot_node; nodes:"),
         (["device_node", "device_node"], 2, "ERROR: a node is named twice"),
         (["device_node", "--ros-args", "-r", "__node:=x"], 2, "__node:= would give every node"),
-        (["--help"], 0, "usage: container NODE [NODE ...]"),
+        (["--help"], 0, "usage: container [NODE ...]"),
     ],
 )
 def test_the_container_answers_bad_arguments_with_one_line(args, code: int, message: str) -> None:

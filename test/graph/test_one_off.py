@@ -1,5 +1,6 @@
 """A person's one-off command arrives: ``ros2 topic pub --once`` from a fresh process, as a user
-types it at a device running alone in lockstep, steps the device by one sample every time.
+types it at a device running alone in lockstep (its command input opened for this bench work,
+``open_command_input``), steps the device by one sample every time.
 
 The publisher is made as ``ros2 topic pub --once`` makes it (reliable, the default QoS): a new
 process, it waits until it has matched a subscription, publishes once and exits. A reader can
@@ -57,6 +58,8 @@ def test_every_one_off_command_steps_a_lone_lockstep_device(tmp_path) -> None:
             "start_delay_s:=0.0",
             "-p",
             "lockstep_timeout_s:=3600.0",  # no re-send: only the commands move the samples
+            "-p",
+            "open_command_input:=true",  # a person's commands by hand: a bench session
         ],
         env,
         tmp_path / "device.log",

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import signal
 import subprocess
+import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 from ament_index_python.packages import get_package_prefix
@@ -103,7 +106,7 @@ def test_ctrl_c_before_the_node_code_runs_prints_nothing(after_exec_s: float) ->
         out, _ = proc.communicate(timeout=30)  # a lost second signal: TimeoutExpired
         assert b"Traceback" not in out and b"KeyboardInterrupt" not in out, out.decode()
         assert b"Fatal Python error" not in out, out.decode()
-        assert proc.returncode in (0, 130), (proc.returncode, out.decode())
+        assert proc.returncode == 0, (proc.returncode, out.decode())
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -126,27 +129,59 @@ def _mapped(pid: int, library: str) -> bool:
         return False
 
 
-#: start-up phases at which the SIGINT comes: the node's imports under way (numpy's extension
-#: mapped, rclpy's not yet or just), and rclpy loaded (its extension mapped; node being built)
+#: start-up phases at which the signal comes: the node's imports under way (numpy's extension
+#: mapped, rclpy's not yet or just), rclpy loaded (its extension mapped; node being built), the
+#: node built (its first line printed), and the device waiting for the graph before sample 0
 PHASES = {"importing": "_multiarray_umath", "rclpy_loaded": "_rclpy_pybind11"}
+PRINTED = {"built": "simulated slide device", "discovery": "waiting before sample 0"}
 
 
 #: what each executable is started with (the container: the loop's four nodes, as ros2 launch's)
 START_ARGS = {"container": ["device_node", "environment_node", "observer_node", "controller_node"]}
 
 
-@pytest.mark.parametrize("phase", list(PHASES))
+class Output:
+    """What a child process prints, read line by line in a thread (the pipe never fills)."""
+
+    def __init__(self, proc: subprocess.Popen[bytes]) -> None:
+        self.lines: list[str] = []
+        assert proc.stdout is not None
+        self._thread = threading.Thread(target=self._read, args=(proc.stdout,), daemon=True)
+        self._thread.start()
+
+    def _read(self, stream: Any) -> None:
+        for line in iter(stream.readline, b""):
+            self.lines.append(line.decode(errors="replace"))
+
+    def has(self, text: str) -> bool:
+        return any(text in line for line in list(self.lines))
+
+    def text(self, proc: subprocess.Popen[bytes]) -> str:
+        proc.wait(30)  # a lost signal: TimeoutExpired
+        self._thread.join(10)
+        return "".join(self.lines)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("phase", [*PHASES, *PRINTED])
 @pytest.mark.parametrize(
     ("package", "name"),
     [("haptic_sim", "device_node"), ("haptic_dob", "controller_node"), ("haptic_dob", "container")],
     ids=["device_node", "controller_node", "container"],
 )
-def test_ctrl_c_during_start_up_ends_quietly(package: str, name: str, phase: str) -> None:
-    """``ros2 launch`` or a terminal sends SIGINT while the node still imports numpy, pinocchio
-    and rclpy or builds itself: it ends at once, with 130 (still importing) or 0 (its clean
-    shutdown), never with a traceback, and the signal is never lost. (A SIGINT within the
-    interpreter's own first tenth of a second, while it reads its site packages, is CPython's
-    to handle and may print its traceback; the shim keeps the wheels' re-exec out of the way.)"""
+def test_a_signal_during_start_up_ends_quietly_with_0(
+    package: str, name: str, phase: str, sig: signal.Signals
+) -> None:
+    """``ros2 launch`` or a terminal sends SIGINT (``ros2 launch`` SIGTERM after it) while the
+    node still imports numpy, pinocchio and rclpy, builds itself or waits for the graph: it ends
+    at once with exit 0, as ``ros2 launch`` counts a clean end, never with a traceback, and the
+    signal is never lost. Each phase is reached by what the process did (a library mapped, a line
+    printed), not by a delay. (A SIGINT within the interpreter's own first tenth of a second,
+    before the entry point runs, is ignored by the shim; ``test_ctrl_c_before_the_node_code``.)"""
+    if phase in PRINTED and name == "controller_node":
+        pytest.skip("the controller prints nothing while it starts")
+    if phase == "discovery" and name == "container":
+        pytest.skip("the composed loop does not wait for the graph long")
     exe = Path(get_package_prefix(package)) / "lib" / package / name
     proc = subprocess.Popen(
         [str(exe), *START_ARGS.get(name, [])],
@@ -154,15 +189,79 @@ def test_ctrl_c_during_start_up_ends_quietly(package: str, name: str, phase: str
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
     )
+    out = Output(proc)
     try:
         # a hang guard: the phase comes within the start-up
-        wait_until(lambda: _mapped(proc.pid, PHASES[phase]), 60.0, poll_s=0.002)
-        assert proc.poll() is None, "the node ended by itself"
-        proc.send_signal(signal.SIGINT)
-        out, _ = proc.communicate(timeout=30)  # lost signal: TimeoutExpired
-        assert b"Traceback" not in out and b"KeyboardInterrupt" not in out, out.decode()
-        assert proc.returncode in (0, 130), (proc.returncode, out.decode())
+        if phase in PHASES:
+            reached = wait_until(lambda: _mapped(proc.pid, PHASES[phase]), 60.0, poll_s=0.002)
+        else:
+            reached = wait_until(lambda: out.has(PRINTED[phase]), 60.0, poll_s=0.002)
+        assert reached and proc.poll() is None, out.text(proc)
+        proc.send_signal(sig)
+        text = out.text(proc)
+        assert "Traceback" not in text and "KeyboardInterrupt" not in text, text
+        assert proc.returncode == 0, (proc.returncode, text)
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait(5)
+
+
+def test_the_container_runs_the_loop_nodes_its_params_file_names(root) -> None:
+    """``ros2 run haptic_dob container --ros-args --params-file FILE``, as the docs write it, runs
+    the nodes the file's sections name (it exited 2, "name at least one node to run")."""
+    exe = Path(get_package_prefix("haptic_dob")) / "lib" / "haptic_dob" / "container"
+    env = isolated_env()
+    config = root / "config" / "slide_sim.yaml"
+    proc = subprocess.Popen(
+        [str(exe), "--ros-args", "--params-file", str(config), "-p", "device_node:duration_s:=0.0"],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+    )
+    out = Output(proc)
+    try:
+        loop = {"device_node", "environment_node", "observer_node", "controller_node"}
+
+        def all_up() -> bool:
+            return proc.poll() is not None or loop <= node_names(env)
+
+        assert wait_until(all_up, 60, poll_s=0.5) and proc.poll() is None, out.text(proc)
+        proc.send_signal(signal.SIGINT)
+        text = out.text(proc)
+        assert proc.returncode == 0, text
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(5)
+
+
+def test_a_bare_p_that_a_node_section_shadows_is_said_with_what_to_type(root) -> None:
+    """``--params-file config/slide_sim.yaml -p clock_mode:=realtime``: the file's device section
+    wins (rcl's order) and the device says so at start-up, with the form that reaches it; typed
+    that way, the device runs in real time."""
+    exe = Path(get_package_prefix("haptic_sim")) / "lib" / "haptic_sim" / "device_node"
+    config = str(root / "config" / "slide_sim.yaml")
+    said: list[str] = []
+    for rule in ("clock_mode:=realtime", "device_node:clock_mode:=realtime"):
+        proc = subprocess.Popen(
+            [str(exe), "--ros-args", "--params-file", config, "-p", rule],
+            env=isolated_env(),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+        )
+        out = Output(proc)
+        try:
+            built = functools.partial(out.has, "simulated slide device")
+            assert wait_until(built, 60, poll_s=0.01), out.text(proc)
+            proc.send_signal(signal.SIGINT)
+            said.append(out.text(proc))
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(5)
+    bare, qualified = said
+    shadow = [line for line in bare.splitlines() if "ignored -p clock_mode:=realtime" in line]
+    assert len(shadow) == 1 and "lockstep" in bare, bare
+    assert "type -p device_node:clock_mode:=realtime after the last --params-file" in shadow[0]
+    assert "realtime at 1000 Hz" in qualified and "ignored" not in qualified, qualified

@@ -1,20 +1,38 @@
-"""How fast this machine turns the loop over, measured by the suite itself (once per layout).
+"""Whether this machine can carry a loop in real time, measured by the suite itself (once per
+layout): the CPU a cycle costs, against the CPU a period gives, and the DDS floor of its path.
 
 A test whose premise is real time at 1 kHz (the device ticking on the wall clock, commands due
-before the next tick) can only hold on a machine that turns the same loop over, in the same
-process layout, well inside a period. The measurement is a short lockstep run of that layout:
-its real-time factor is how many periods of loop work fit in one period of wall time. Below
-``REQUIRED_RTF`` such a test skips, saying the figure; every other test runs whatever the machine.
-A loop across processes also waits on DDS between them, however little work its nodes do: the
-raw hop (``haptic_dob.runtime.ros.dds_hop``) times the hops on the command's path must fit in
-``HOPS_SHARE`` of a period, or the test skips, saying that figure.
+before the next tick) holds on a machine where the loop's work of a cycle fits in a period. The
+measurement is a short lockstep run of the same layout (the same processes, nodes and topics the
+test watches): the CPU time (user + system, from ``/proc``) its processes spend from sample 0 to
+the last, over its cycles, which is what a cycle costs in real time too, however long lockstep's
+own hand-overs make a cycle last. It holds when
+
+- the cycle's CPU across the loop's processes (and this test's watchers) fits in ``CPU_SHARE``
+  of the CPUs the run may use times the period: the CPUs of its affinity, less what other
+  processes kept busy on them meanwhile (``/proc/stat``; on a machine others load, a loop that
+  would fit an idle one misses its ticks), and
+- the busiest process's fits in ``CPU_SHARE`` of one period (a process works its cycle through
+  in one spin thread), and
+- across processes, the raw DDS hops on the command's path (``haptic_dob.runtime.ros.dds_hop``)
+  fit in ``HOPS_SHARE`` of a period: no node goes under that floor.
+
+Otherwise the test skips, saying the figures. (It replaced the lockstep real-time factor, which
+counts every hand-over's wake-up as work: it skipped 7 of 8 real-time tests on a machine where a
+composed real-time session kept every command on time.)
 """
 
 from __future__ import annotations
 
+import os
 import re
 import subprocess
+import threading
+import time
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from itertools import pairwise
+from pathlib import Path
 
 import pytest
 
@@ -22,11 +40,13 @@ from haptic_dob.runtime.ros.dds_hop import hop_us
 from support.paths import BIN, ROOT
 from support.rosgraph import Collector, isolated_env, random_domain
 
-#: the loop work of a cycle must fit in 5/6 of a period: a sixth of it left for the jitter of a
-#: loaded machine (the device's watchdog zeroes the force after five late periods)
-REQUIRED_RTF = 1.2
+#: the loop's CPU of a cycle must fit in this share of what a period gives: the rest is the
+#: jitter of a loaded machine and the wake-ups that lockstep does not have (the device's tick)
+CPU_SHARE = 0.8
 MEASURE_S = 2.0  # simulated seconds of the lockstep measurement
 PROBE_TIMEOUT_S = 200  # wall seconds the probe may take (the tests' own timeout is 300 s)
+SAMPLE_S = 0.01  # how often the probe reads the processes' CPU times
+TICK_S = 1.0 / os.sysconf("SC_CLK_TCK")  # the resolution of /proc/PID/stat's CPU times
 
 #: the raw DDS hops between processes on a real-time loop's path may take at most this share of a
 #: period: the rest is the device's tick (its wake-up, the plant step, its publishing), the nodes'
@@ -38,20 +58,65 @@ PROBE_TIMEOUT_S = 200  # wall seconds the probe may take (the tests' own timeout
 HOPS_SHARE = 0.5
 HOP_MESSAGES = 2000  # round trips of one hop measurement (about 1 s)
 
-_measured: dict[tuple[tuple[str, ...], ...], float] = {}
+#: the command's paths through the loop's nodes (OL and CL: the wall; DOB: the observer too)
+PATHS = {
+    "OL": (("device_node", "environment_node", "controller_node", "device_node"),),
+    "DOB": (
+        ("device_node", "environment_node", "controller_node", "device_node"),
+        ("device_node", "observer_node", "controller_node", "device_node"),
+    ),
+}
 
 
-def lockstep_rtf(
+@dataclass(frozen=True)
+class CycleCost:
+    """What a cycle of a layout costs this machine now (µs of CPU) and what it has."""
+
+    total_us: float  # CPU of a cycle across the loop's processes and this test's watchers
+    busiest_us: float  # the busiest process's
+    processes: int  # the loop's processes
+    cpus: int  # the CPUs of the run's affinity
+    others: float  # CPUs of those that other processes kept busy during the measurement
+    period_us: float
+
+    @property
+    def free(self) -> float:
+        """The CPUs the run may use: its affinity's, less what others kept busy."""
+        return max(0.0, self.cpus - self.others)
+
+    def fits(self) -> bool:
+        """The cycle's CPU fits in ``CPU_SHARE`` of the free CPUs' period, the busiest
+        process's in ``CPU_SHARE`` of one period."""
+        return (
+            self.total_us <= CPU_SHARE * self.free * self.period_us
+            and self.busiest_us <= CPU_SHARE * self.period_us
+        )
+
+    def text(self) -> str:
+        """The figures, as a skip says them."""
+        return (
+            f"a cycle costs {self.total_us:.0f} us of CPU across {self.processes} process(es) "
+            f"(the busiest {self.busiest_us:.0f} us), measured now in lockstep; real time at "
+            f"{1e6 / self.period_us:g} Hz needs at most {CPU_SHARE:g} x {self.free:.2f} free "
+            f"CPU(s) ({self.cpus} less {self.others:.2f} that others kept busy) x "
+            f"{self.period_us:.0f} us = {CPU_SHARE * self.free * self.period_us:.0f} us "
+            f"(the busiest at most {CPU_SHARE * self.period_us:.0f} us)"
+        )
+
+
+_measured: dict[tuple[tuple[str, ...], ...], CycleCost] = {}
+
+
+def cycle_cost(
     groups: Sequence[Sequence[str]],
     mode: str = "OL",
     sets: Sequence[str] = (),
     watched: Mapping[str, str] | None = None,
-) -> float:
-    """The lockstep real-time factor of the slide loop with ``groups`` sharing processes (nodes
-    in no group alone; ``[]``: four processes), in ``mode``, with ``sets`` (``haptic-launch
-    --set``), and with this process watching the ``watched`` topics (topic -> type) as the
-    calling test will (a ``rosgraph.Collector``: its CPU is the test's load beside the loop,
-    which on one core the loop shares); measured once per layout."""
+) -> CycleCost:
+    """The CPU a cycle of the slide loop costs with ``groups`` sharing processes (nodes in no
+    group alone; ``[]``: four processes), in ``mode``, with ``sets`` (``haptic-launch --set``),
+    and with this process watching the ``watched`` topics (topic -> type) as the calling test
+    will (a ``rosgraph.Collector``: its CPU counts); measured once per layout."""
     key = (*(tuple(sorted(g)) for g in groups), (mode, *sets), tuple(sorted(watched or {})))
     if key not in _measured:
         argv = [str(BIN / "haptic-launch"), str(ROOT / "config" / "slide_sim.yaml")]
@@ -63,14 +128,13 @@ def lockstep_rtf(
     return _measured[key]
 
 
-def teleop_lockstep_rtf(
+def teleop_cycle_cost(
     composed: bool = True, watched: Mapping[str, Mapping[str, str]] | None = None
-) -> float:
-    """The lockstep real-time factor of the teleoperation graph, the slower device's, each
-    channel end using what has come as in real time (so that each side runs at its own pace),
-    with this process watching ``watched`` (namespace -> topic -> type) as the calling test will;
-    measured once per layout: ``composed`` every node in one process, else a process per side
-    (real time's default)."""
+) -> CycleCost:
+    """The CPU a cycle of the teleoperation graph costs (both sides), each channel end using
+    what has come as in real time, with this process watching ``watched`` (namespace -> topic
+    -> type) as the calling test will; measured once per layout: ``composed`` every node in one
+    process, else a process per side (real time's default)."""
     watching = tuple(f"{ns}/{t}" for ns, topics in sorted((watched or {}).items()) for t in topics)
     key = (("teleop_sim", "composed" if composed else "sides"), watching)
     if key not in _measured:
@@ -82,32 +146,143 @@ def teleop_lockstep_rtf(
     return _measured[key]
 
 
-def _probe(argv: list[str], watched: Mapping[str, Mapping[str, str]] | None = None) -> float:
+def _cpu_s(pid: int | str) -> float | None:
+    """User + system CPU time (s) of process ``pid`` so far, None once it is gone."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return None
+    return (int(fields[11]) + int(fields[12])) * TICK_S  # utime, stime
+
+
+def _busy_s(cpus: set[int]) -> float:
+    """Time (s) the CPUs ``cpus`` spent busy so far, every process's (``/proc/stat``)."""
+    busy = 0
+    for line in Path("/proc/stat").read_text().splitlines():
+        name, *fields = line.split()
+        if name.startswith("cpu") and name[3:].isdigit() and int(name[3:]) in cpus:
+            user, nice, system, _idle, _iowait, irq, softirq, steal = map(int, fields[:8])
+            busy += user + nice + system + irq + softirq + steal
+    return busy * TICK_S
+
+
+def _children(pid: int) -> list[int]:
+    """The child processes of ``pid`` (the launcher's nodes)."""
+    out: list[int] = []
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        try:
+            out += [int(c) for c in (task / "children").read_text().split()]
+        except OSError:
+            continue
+    return out
+
+
+class _Sampler:
+    """The CPU times of the launcher's child processes and of this one, read every
+    ``SAMPLE_S`` in a thread while the run goes on: (monotonic s, {pid: CPU s})."""
+
+    def __init__(self, launcher: int) -> None:
+        self.launcher = launcher
+        self.cpus = os.sched_getaffinity(0)
+        self.rows: list[tuple[float, dict[int | str, float]]] = []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.wait(SAMPLE_S):
+            row: dict[int | str, float] = {}
+            for pid in _children(self.launcher):
+                cpu = _cpu_s(pid)
+                if cpu is not None:
+                    row[pid] = cpu
+            own = _cpu_s("self")
+            if own is not None:
+                row["self"] = own
+            row["busy"] = _busy_s(self.cpus)
+            self.rows.append((time.monotonic(), row))
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(5)
+
+    def at(self, t: float) -> dict[int | str, float]:
+        """The CPU times read last at or before ``t`` (monotonic s)."""
+        before = [row for when, row in self.rows if when <= t]
+        return before[-1] if before else {}
+
+
+def _probe(argv: list[str], watched: Mapping[str, Mapping[str, str]] | None = None) -> CycleCost:
     """Run a lockstep launch, with collectors of ``watched`` (namespace -> topic -> type) in
-    this process while it runs; the lowest real-time factor its devices report."""
+    this process while it runs; the CPU of a cycle from sample 0 to each device's last."""
     env = isolated_env()
     # no back pressure: the devices do not wait for them (as in real time), their CPU is the load
     cols = [
         Collector(env, dict(topics), name=f"probe_{i}", namespace=ns, back_pressure=False)
         for i, (ns, topics) in enumerate(sorted((watched or {}).items()))
     ]
+    finished: list[tuple[float, int, float]] = []  # (when said, cycles, wall s since sample 0)
+    lines: list[str] = []
     # inside the test's own timeout, so a stuck probe says what it printed; SIGTERM lets
     # haptic-launch stop the nodes it started (a SIGKILL would orphan them)
     proc = subprocess.Popen(
-        argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
     )
+    sampler = _Sampler(proc.pid)
+    # rcutils stamps each line with the system clock: when the device said it, however late the
+    # line reaches this process
+    pattern = re.compile(
+        r"\[(\d+\.\d+)\] \[[^]]*device_node\]: finished: (\d+) cycles .* in ([0-9.]+) s"
+    )
+    to_monotonic = time.monotonic() - time.time()
     try:
-        stdout, stderr = proc.communicate(timeout=PROBE_TIMEOUT_S)
-    except subprocess.TimeoutExpired:
-        proc.terminate()
-        stdout, stderr = proc.communicate(timeout=60)
-        pytest.fail(f"the capacity probe ran over {PROBE_TIMEOUT_S} s:\n{stderr[-2000:]}")
+        assert proc.stdout is not None
+        t_end = time.monotonic() + PROBE_TIMEOUT_S
+        for line in proc.stdout:  # read as said: the time a device finished is when it says so
+            lines.append(line)
+            found = pattern.search(line)
+            if found:
+                said, cycles, wall = found.groups()
+                finished.append((float(said) + to_monotonic, int(cycles), float(wall)))
+            if time.monotonic() > t_end:
+                proc.terminate()
+                proc.wait(60)
+                said = "".join(lines)[-2000:]
+                pytest.fail(f"the capacity probe ran over {PROBE_TIMEOUT_S} s:\n{said}")
+        proc.wait(60)
     finally:
+        sampler.stop()
         for col in reversed(cols):
             col.close()
-    found = re.findall(r"real-time factor ([0-9.]+)", stderr + stdout)
-    assert proc.returncode == 0 and found, stderr[-2000:]
-    return min(float(f) for f in found)
+    assert proc.returncode == 0 and finished, "".join(lines)[-2000:]
+    start = min(t - wall for t, _, wall in finished)  # sample 0 of the first device
+    end = max(t for t, _, _ in finished)
+    cycles = max(n for _, n, _ in finished)
+    first, last = sampler.at(start), sampler.at(end)
+    spent = {p: last[p] - first.get(p, 0.0) for p in last if p not in ("self", "busy")}
+    own = last.get("self", 0.0) - first.get("self", 0.0)
+    busy = last.get("busy", 0.0) - first.get("busy", 0.0)
+    others = max(0.0, busy - sum(spent.values()) - own) / max(end - start, SAMPLE_S)
+    return CycleCost(
+        total_us=(sum(spent.values()) + (own if watched else 0.0)) * 1e6 / cycles,
+        busiest_us=max(spent.values(), default=0.0) * 1e6 / cycles,
+        processes=len(spent),
+        cpus=len(sampler.cpus),
+        others=others,
+        period_us=1e6 / 1000.0,
+    )
+
+
+def path_hops(groups: Sequence[Sequence[str]], mode: str) -> int:
+    """Raw DDS hops between processes on the command's slowest path with ``groups`` sharing
+    processes (nodes in no group alone)."""
+    home = {n: i for i, g in enumerate(groups) for n in g}
+
+    def process(node: str) -> object:
+        return home.get(node, node)
+
+    paths = PATHS["DOB" if mode == "DOB" else "OL"]
+    return max(sum(process(a) != process(b) for a, b in pairwise(p)) for p in paths)
 
 
 def require_realtime(
@@ -115,38 +290,34 @@ def require_realtime(
     mode: str = "OL",
     sets: Sequence[str] = (),
     watched: Mapping[str, str] | None = None,
-) -> float:
-    """Skip the calling test unless this machine turns this layout over at ``REQUIRED_RTF`` times
-    real time or faster (now, under whatever else runs, with the test watching ``watched``);
-    returns the figure."""
-    rtf = lockstep_rtf(groups, mode, sets, watched)
-    if rtf < REQUIRED_RTF:
-        layout = " | ".join(", ".join(g) for g in groups) or "four processes"
+) -> CycleCost:
+    """Skip the calling test unless a cycle of this layout (``cycle_cost``, with the test
+    watching ``watched``) fits in what this machine's CPUs give a period, now, and its DDS
+    hops across processes fit in ``HOPS_SHARE`` of a period; returns the cost."""
+    cost = cycle_cost(groups, mode, sets, watched)
+    layout = " | ".join(", ".join(g) for g in groups) or "four processes"
+    if not cost.fits():
         watching = f", this test watching {len(watched)} topics" if watched else ""
-        pytest.skip(
-            f"this machine turns the loop ({layout}; {mode}{watching}) over at {rtf:.2f}x real "
-            f"time in lockstep, measured now; real time at 1 kHz needs {REQUIRED_RTF:g}x"
-        )
-    return rtf
+        pytest.skip(f"{layout}; {mode}{watching}: {cost.text()}")
+    hops = path_hops(groups, mode)
+    if hops:
+        require_hop_floor(hops, hop_floor_us())
+    return cost
 
 
 def require_realtime_teleop(
     composed: bool = True, watched: Mapping[str, Mapping[str, str]] | None = None
-) -> float:
-    """Skip the calling test unless this machine turns the teleoperation graph in that layout
-    (``teleop_lockstep_rtf``, with the test watching ``watched``) over at ``REQUIRED_RTF`` times
-    real time or faster in lockstep (now); returns the slower side's figure."""
-    rtf = teleop_lockstep_rtf(composed, watched)
-    if rtf < REQUIRED_RTF:
+) -> CycleCost:
+    """Skip the calling test unless a cycle of the teleoperation graph in that layout
+    (``teleop_cycle_cost``, with the test watching ``watched``) fits in what this machine's CPUs
+    give a period, now; returns the cost."""
+    cost = teleop_cycle_cost(composed, watched)
+    if not cost.fits():
         layout = "all in one process" if composed else "a process per side"
         if watched:
             layout += f", this test watching {sum(len(t) for t in watched.values())} topics"
-        pytest.skip(
-            f"this machine turns the teleoperation graph ({layout}) over at {rtf:.2f}x real time "
-            f"in lockstep (the slower side), measured now; real time at 1 kHz needs "
-            f"{REQUIRED_RTF:g}x"
-        )
-    return rtf
+        pytest.skip(f"the teleoperation graph ({layout}): {cost.text()}")
+    return cost
 
 
 def hop_floor_us() -> float:

@@ -1,8 +1,9 @@
 """Bags of a driver's ``joint_states`` as ``ros2 bag record`` would hold them (rosbags, MCAP and
-sqlite3), from a 1-DOF record."""
+sqlite3), from a 1-DOF record or from several joints' arrays."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +33,34 @@ def write_bag(
             msg.position = np.array([q])
             msg.velocity = np.array([0.0])
             msg.effort = np.array([u]) if effort else np.array([], np.float64)
+            writer.write(conn, int(st) + 1, wire.encode(msg))
+    finally:
+        writer.close()
+    return path
+
+
+def write_joint_states(
+    path: Path,
+    stamps_ns: np.ndarray,
+    names: Sequence[str],
+    position: np.ndarray,
+    effort: np.ndarray,
+    storage: str = "mcap",
+    topic: str = "/joint_states",
+) -> Path:
+    """A bag of ``topic`` holding position and effort of ``names`` (arrays (N, n)) and no
+    velocity, as a position-only driver's ``joint_states`` with the effort it applied."""
+    plugin = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}[storage]
+    writer = Writer(path, version=9, storage_plugin=plugin)
+    writer.open()
+    try:
+        conn = writer.add_connection(topic, "sensor_msgs/msg/JointState", typestore=wire.TYPESTORE)
+        msg = wire.joint_state(list(names), "base_link")
+        msg.velocity = np.array([], np.float64)
+        for st, q, u in zip(stamps_ns.tolist(), position, effort, strict=True):
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(st), 10**9)
+            msg.position = np.asarray(q, np.float64)
+            msg.effort = np.asarray(u, np.float64)
             writer.write(conn, int(st) + 1, wire.encode(msg))
     finally:
         writer.close()

@@ -45,11 +45,15 @@ def random_domains(n: int) -> list[int]:
 
 
 def isolated_env(domain: int | None = None) -> dict[str, str]:
-    """This environment with a random domain id (``random_domain``) and localhost-only
-    discovery."""
+    """This environment with a random domain id (``random_domain``), localhost-only discovery,
+    and the nodes' log lines written as they are said (unbuffered, whichever stream rcutils
+    writes: a test whose evidence is a log line reads it while the process runs, and a
+    ``RCUTILS_LOGGING_USE_STDOUT`` of the caller's would leave lines in a file's block buffer
+    until the process ends, or lose them when it is killed)."""
     env = dict(os.environ)
     env["ROS_DOMAIN_ID"] = str(domain if domain is not None else random_domain())
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    env["RCUTILS_LOGGING_BUFFERED_STREAM"] = "0"
     env.pop("ROS_STATIC_PEERS", None)
     return env
 
@@ -126,6 +130,7 @@ class Collector:
     the device sends sample 0 only once it has matched and a lockstep device waits for it when a
     loaded machine leaves it behind, instead of running past the publishers' history
     (``back_pressure=False`` turns that off, e.g. for topics that stop while the loop goes on).
+    ``best_effort=True`` subscribes to everything best effort, as a sensor-data reader does.
     """
 
     def __init__(
@@ -135,13 +140,14 @@ class Collector:
         name: str = "collector",
         namespace: str = "",
         back_pressure: bool = True,
+        best_effort: bool = False,
     ) -> None:
         import rclpy
         from rclpy.context import Context
         from rclpy.experimental import EventsExecutor
 
+        from haptic_dob.bag.cdr import stamp_reader
         from haptic_dob.recorder.counts import RecordingCounts
-        from haptic_dob.recorder.topics import stamp_reader
         from haptic_msgs_py.ros.qos import CLOCK, RECORD
         from haptic_msgs_py.ros.raw import rclpy_type
         from haptic_msgs_py.topics import RECORDER_PROGRESS, SESSION_TOPICS
@@ -184,6 +190,8 @@ class Collector:
                         count.wrote(read(data), 1_000_000)
 
             qos = RECORD if topic in SESSION_TOPICS else volatile
+            if best_effort:  # as a sensor-data reader takes them (ext_observer_ros, say)
+                qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
             self._subs[topic] = self.node.create_subscription(
                 rclpy_type(typename), topic, cb, qos, raw=True
             )

@@ -13,13 +13,16 @@ CDR, mixed lengths) goes through the ``rosbags`` deserializer, which is exact bu
 from __future__ import annotations
 
 import struct
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from haptic_msgs_py.stamps import COMMAND_LABEL, NS_PER_S
+from haptic_msgs_py.stamps import COMMAND_LABEL, NS_PER_S, TOKEN_MARK
+from haptic_msgs_py.topics import EFFORT_COMMAND
 from haptic_msgs_py.wire import TYPESTORE
+
+StampReader = Callable[[bytes], int | None]
 
 #: stamped geometry types: the message's 3-vector field read as components 0..2 after the header
 VECTOR_FIELD: dict[str, tuple[str, str]] = {
@@ -47,7 +50,8 @@ def header_stamp_ns(data: bytes | memoryview) -> int | None:
 
 
 def command_label_stamp_ns(data: bytes | memoryview) -> int | None:
-    """The stamp named by a little-endian ``Float64MultiArray``'s first label (``effort@<ns>``)."""
+    """The stamp named by a little-endian ``Float64MultiArray``'s first label (``effort@<ns>``,
+    a sender's ``#<token>`` after it)."""
     if len(data) < 12 or data[1] != 1 or _U32.unpack_from(data, 4)[0] < 1:
         return None
     n = _U32.unpack_from(data, 8)[0]
@@ -55,9 +59,23 @@ def command_label_stamp_ns(data: bytes | memoryview) -> int | None:
     if not label.startswith(COMMAND_LABEL.encode()):
         return None
     try:
-        return int(label[len(COMMAND_LABEL) :])
+        return int(label[len(COMMAND_LABEL) :].partition(TOKEN_MARK.encode())[0])
     except ValueError:
         return None
+
+
+def stamp_reader(
+    topic: str, typename: str, fielddefs: Mapping[str, Any] = TYPESTORE.fielddefs
+) -> StampReader | None:
+    """How to read the stamp (ns) of a message of ``topic`` from its bytes: its header's, or an
+    ``effort_command``'s label; None when it carries none. ``fielddefs``: a rosbags typestore's
+    (one that knows ``typename``)."""
+    fields = fielddefs[typename][1]
+    if fields and fields[0][0] == "header":
+        return header_stamp_ns
+    if topic.rsplit("/", 1)[-1] == EFFORT_COMMAND:
+        return command_label_stamp_ns
+    return None
 
 
 def decode_vectors(

@@ -2,15 +2,16 @@
 
 A rosbag2 directory gets its ``metadata.yaml`` only when the writer closes; an MCAP file gets its
 summary, footer and end magic then too, and a sqlite3 file commits then. The recorder therefore
-closes an MCAP chunk (and flushes it to the operating system) or commits the sqlite3 transaction
-at least once a second (``RecordingWriter``), so a killed recording holds everything but its last
-second in complete records.
+closes an MCAP chunk (flushed and synced) or commits the sqlite3 transaction whenever a topic's
+stamps have advanced a second of session time (``haptic_dob.recorder.recording``), so a killed
+recording holds all but at most its last second of each topic in complete records.
 
 ``recover`` reads what is complete, without changing the original: for MCAP every record up to the
 first incomplete one (a data-end record and a footer are added to a private copy, which rosbags
 then reads by scanning), for sqlite3 every committed row (the private copy's journal is rolled
 back by sqlite itself). It writes a new, closed bag (same storage, same topics, types and QoS)
-that every tool opens, and says what it recovered.
+that every tool opens, keeping every complete message, and says per topic where its stamps end
+(topics written at one moment end at different stamps: docs/recording-and-analysis.md).
 """
 
 from __future__ import annotations
@@ -20,17 +21,41 @@ import shutil
 import sqlite3
 import struct
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from haptic_dob.bag.cdr import stamp_reader
 from haptic_dob.bag.errors import BagError
+from haptic_dob.bag.write import open_writer
+from haptic_msgs_py.stamps import NS_PER_S
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 RECOVERED_KEY = "haptic_dob.recovered"  # custom data of a recovered bag: where it came from
 _OP_DATA_END = 0x0F
 _OP_FOOTER = 0x02
 _RECORD_HEAD = 9  # opcode (1 byte) + record length (uint64)
+
+
+@dataclass(frozen=True)
+class TopicEnd:
+    """One recovered topic: its messages and the stamps of its first and last (header stamps or
+    command labels; None for a topic that carries none)."""
+
+    topic: str
+    messages: int
+    first_ns: int | None
+    last_ns: int | None
+
+    def line(self) -> str:
+        """``<topic>: N messages[, stamps A-B s]``."""
+        span = (
+            ""
+            if self.first_ns is None or self.last_ns is None
+            else (f", stamps {self.first_ns / NS_PER_S:.3f}-{self.last_ns / NS_PER_S:.3f} s")
+        )
+        return f"{self.topic}: {self.messages} messages{span}"
 
 
 @dataclass(frozen=True)
@@ -44,6 +69,13 @@ class Recovery:
     topics: int
     duration_s: float  # from the first to the last recovered message
     dropped_bytes: int  # MCAP: the incomplete tail left out (sqlite3: 0)
+    ends: tuple[TopicEnd, ...] = ()  # per topic, in the bag's order
+
+    @property
+    def common_end_ns(self) -> int | None:
+        """The newest stamp every stamped topic reached (ns); None without a stamped topic."""
+        lasts = [e.last_ns for e in self.ends if e.last_ns is not None]
+        return min(lasts) if lasts else None
 
     def as_json(self) -> dict[str, Any]:
         """What the recovered bag's metadata says of its origin (custom data ``RECOVERED_KEY``)."""
@@ -52,18 +84,36 @@ class Recovery:
             "storage": self.storage,
             "messages": self.messages,
             "dropped_bytes": self.dropped_bytes,
+            "topics": {
+                e.topic: {
+                    "messages": e.messages,
+                    "first_stamp_ns": e.first_ns,
+                    "last_stamp_ns": e.last_ns,
+                }
+                for e in self.ends
+            },
+            "common_end_stamp_ns": self.common_end_ns,
         }
 
     def summary(self) -> str:
-        """One line for the user."""
+        """What was recovered, for the user: a line, a line per topic, where every one ends."""
         tail = f"; left out an incomplete tail of {self.dropped_bytes} bytes" * bool(
             self.dropped_bytes
         )
-        return (
+        lines = [
             f"recovered {self.messages} messages on {self.topics} topics "
             f"({self.duration_s:.3f} s) from {self.source} into {self.out} "
             f"({self.storage}){tail}"
-        )
+        ]
+        lines += [f"  {e.line()}" for e in self.ends]
+        common = self.common_end_ns
+        if common is not None:
+            newest = max(e.last_ns for e in self.ends if e.last_ns is not None)
+            lines.append(
+                f"every stamped topic reaches {common / NS_PER_S:.3f} s"
+                + (f"; after it only some do, up to {newest / NS_PER_S:.3f} s" * (newest > common))
+            )
+        return "\n".join(lines)
 
 
 def complete_mcap_prefix(data: bytes | memoryview) -> int:
@@ -167,10 +217,30 @@ def _typestore(conns: list[Any], path: Path) -> Any:
     return typestore
 
 
+class _Span:
+    """The messages of one topic and the span of their stamps, as they are read."""
+
+    def __init__(self, stamp_of: Callable[[bytes], int | None] | None) -> None:
+        self.stamp_of = stamp_of
+        self.messages = 0
+        self.first: int | None = None
+        self.last: int | None = None
+
+    def add(self, data: bytes) -> None:
+        self.messages += 1
+        stamp = None if self.stamp_of is None else self.stamp_of(data)
+        if stamp is not None:
+            self.first = stamp if self.first is None else min(self.first, stamp)
+            self.last = stamp if self.last is None else max(self.last, stamp)
+
+    def end(self, topic: str) -> TopicEnd:
+        return TopicEnd(topic, self.messages, self.first, self.last)
+
+
 def recover(bag: str | Path, out: str | Path | None = None) -> Recovery:
     """Write the complete part of the killed recording ``bag`` to a new bag ``out`` (default:
     ``<bag>_recovered``). Raises ``BagError`` (one line) when there is nothing to recover."""
-    from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
+    from rosbags.rosbag2 import WriterError
     from rosbags.rosbag2.errors import ReaderError
 
     bag = Path(bag)
@@ -191,10 +261,8 @@ def recover(bag: str | Path, out: str | Path | None = None) -> Recovery:
             conns = list(reader.connections)
             if not conns:
                 raise BagError(f"{path}: no complete topic record (killed in its first second?)")
-            plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
-            writer = Writer(target, version=9, storage_plugin=plugin)
             try:
-                writer.open()
+                writer = open_writer(target, storage)
             except (WriterError, OSError) as exc:
                 raise BagError(f"{target}: cannot create the recovered bag ({exc})") from None
             typestore = _typestore(conns, path)
@@ -208,14 +276,19 @@ def recover(bag: str | Path, out: str | Path | None = None) -> Recovery:
                 )
                 for c in conns
             }
+            ends = {
+                c.id: _Span(stamp_reader(c.topic, c.msgtype, typestore.fielddefs)) for c in conns
+            }
             count, first, last = 0, None, None
             for conn, stamp, data in _in_file_order(reader, conns, storage):
                 writer.write(added[conn.id], stamp, data)
+                ends[conn.id].add(data)
                 count += 1
                 first = stamp if first is None else min(first, stamp)
                 last = stamp if last is None else max(last, stamp)
             span = (last - first) * 1e-9 if first is not None and last is not None else 0.0
-            got = Recovery(bag, target, storage, count, len(conns), span, dropped)
+            topics = tuple(ends[c.id].end(c.topic) for c in conns)
+            got = Recovery(bag, target, storage, count, len(conns), span, dropped, topics)
             writer.set_custom_data(RECOVERED_KEY, json.dumps(got.as_json()))
             writer.close()
         finally:

@@ -210,14 +210,17 @@ def parameter_event(
 
 
 def open_writer(path: str | Path, storage: str) -> Writer:
-    """An open ``rosbags`` writer of a new bag (rosbag2 format 9) in ``storage`` (mcap, sqlite3).
+    """An open ``rosbags`` writer of a new bag (rosbag2 format 9, as Jazzy writes it:
+    ``haptic_dob.bag.jazzy``) in ``storage`` (mcap, sqlite3).
 
     Raises ``rosbags.rosbag2.WriterError`` or ``OSError`` when the bag cannot be created.
     """
-    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.rosbag2 import StoragePlugin
+
+    from haptic_dob.bag.jazzy import JazzyWriter  # rosbags' writer: loaded with it, when used
 
     plugin = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}[storage]
-    writer = Writer(Path(path), version=9, storage_plugin=plugin)
+    writer = JazzyWriter(Path(path), version=9, storage_plugin=plugin)
     writer.open()
     return writer
 

@@ -6,10 +6,12 @@ squares (default) or by the step method under a virtual spring (``--method step`
 ``thesis_step`` for the thesis's formulas verbatim).
 With ``--urdf FILE --tip-frame F`` it identifies an arm's joint friction instead (viscous and
 Coulomb per joint, beyond the URDF's rigid body; ``haptic_dob.identification.arm_friction``), judged
-on held-out data. Prints a table, or one JSON line (``--json``); ``--write-yaml FILE`` writes the
-model as a params file (``slide.*``, or ``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``,
-of the observer and the controller, the nodes that assume a model) to load after the session's
-config.
+on held-out data. With ``--axes X,Y,Z`` it identifies a Cartesian device per axis (mass, viscous
+and Coulomb friction of each; ``haptic_dob.identification.per_axis``), the point-mass model of a
+Force Dimension device (``--axes fd_x,fd_y,fd_z``). Prints a table, or one JSON line
+(``--json``); ``--write-yaml FILE`` writes the model as a params file (``slide.*``,
+``point_mass.*``, or ``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``, of the observer and
+the controller, the nodes that assume a model) to load after the session's config.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from haptic_dob.errors import InputError
 from haptic_dob.identification.arm_friction import ArmFrictionFit
 from haptic_dob.identification.filters import plus_minus
 from haptic_dob.identification.one_dof import METHODS, IdentificationError, SlideFit
+from haptic_dob.identification.per_axis import AxesFit
 
 
 @dataclass(frozen=True)
@@ -64,11 +67,14 @@ MODEL_NODES = ("observer_node", "controller_node")
 
 
 def model_yaml(params: Mapping[str, object], what: str, bag: str) -> str:
-    """A params file that sets ``params`` of the observer's and the controller's model."""
+    """A params file that sets ``params`` of the observer's and the controller's model (each
+    node its own copy of a list: YAML would alias a shared one, and rcl refuses aliases)."""
+    import copy
+
     import yaml
 
     head = f"# identified from {bag} by haptic-identify ({what})\n"
-    doc = {f"/**/{n}": {"ros__parameters": dict(params)} for n in MODEL_NODES}
+    doc = {f"/**/{n}": {"ros__parameters": copy.deepcopy(dict(params))} for n in MODEL_NODES}
     body: str = yaml.safe_dump(doc, sort_keys=False)
     return head + body
 
@@ -116,6 +122,58 @@ def arm_command(bag: str, topic: str, arm: ArmSpec, as_json: bool, write_yaml: s
         print(arm_table(fit, bag))
     if write_yaml:
         text = model_yaml(fit.as_params(), f"joint friction, URDF {arm.urdf}", bag)
+        Path(write_yaml).write_text(text, encoding="utf-8")
+        if not as_json:
+            print(f"model written to {write_yaml}")
+    return 0
+
+
+def axes_table(fit: AxesFit, bag: str) -> str:
+    """Each axis's mass, viscous and Coulomb friction with standard errors (least squares)."""
+    rows = [
+        f"bag {bag}: each axis by least squares",
+        "axis         mass (kg)            viscous (N s/m)      Coulomb (N)          samples  "
+        "rms residual (N)",
+    ]
+    for f in fit.axes:
+        rows.append(
+            f"{f.joint:<12} {plus_minus(f.mass_kg, f.mass_std, '.4f'):<20} "
+            f"{plus_minus(f.viscous_n_s_per_m, f.viscous_std, '.4f'):<20} "
+            f"{plus_minus(f.coulomb_n, f.coulomb_std, '.4f'):<20} {f.samples:<8} "
+            f"{f.rms_residual_n or 0.0:.4f}"
+        )
+    return "\n".join(rows)
+
+
+def parse_axes(text: str) -> tuple[str, str, str]:
+    """``--axes``: three different joint names, comma-separated, in x, y, z order."""
+    names = tuple(n.strip() for n in text.split(","))
+    if len(names) != 3 or not all(names) or len(set(names)) != 3:
+        raise InputError(
+            f"--axes needs three different joint names in x, y, z order (fd_x,fd_y,fd_z), "
+            f"got {text!r}"
+        )
+    return names[0], names[1], names[2]
+
+
+def axes_command(
+    bag: str, topic: str, axes: tuple[str, ...], as_json: bool, write_yaml: str | None
+) -> int:
+    """Identify every axis of a Cartesian device, print, optionally write its point-mass model."""
+    from haptic_dob.bag.joints import read_joints
+    from haptic_dob.identification.per_axis import identify_axes
+
+    js = read_joints(bag, topic, axes)
+    try:
+        fit = identify_axes(js.stamps_ns, js.position, js.effort, js.names)
+    except IdentificationError as exc:
+        raise InputError(f"{bag}: {exc}") from None
+    if as_json:
+        print(json.dumps({"bag": bag, "axes": [f.__dict__ for f in fit.axes]}))
+    else:
+        print(axes_table(fit, bag))
+    if write_yaml:
+        text = model_yaml(fit.as_params(), f"point mass, axes {', '.join(axes)}", bag)
         Path(write_yaml).write_text(text, encoding="utf-8")
         if not as_json:
             print(f"model written to {write_yaml}")
@@ -183,7 +241,27 @@ def main(argv: Sequence[str] | None = None) -> int:
         "low-pass (default: the fit's 20 Hz); a wider one (e.g. 50) resolves a turn of a few "
         "milliseconds where the encoders resolve speeds well below it",
     )
+    p.add_argument(
+        "--axes",
+        metavar="X,Y,Z",
+        help="a Cartesian device: identify each of these joints (x, y, z order; fd_x,fd_y,fd_z "
+        "for a Force Dimension device) as an axis of the point-mass model, by least squares",
+    )
     a = p.parse_args(argv)
+    if a.axes is not None:
+        given = (
+            ("--urdf", a.urdf),
+            ("--tip-frame", a.tip_frame),
+            ("--joints", a.joints),
+            ("--turn-cutoff-hz", a.turn_cutoff_hz is not None),
+            ("--joint", a.joint),
+        )
+        clash = [f for f, on in given if on]
+        if a.method != "least_squares":
+            clash.append("--method")
+        if clash:
+            p.error(f"--axes fits each axis by least squares: leave out {', '.join(clash)}")
+        return run(lambda: axes_command(a.bag, a.topic, parse_axes(a.axes), a.json, a.write_yaml))
     if a.turn_cutoff_hz is not None and not 0.0 < a.turn_cutoff_hz < float("inf"):
         p.error(f"--turn-cutoff-hz must be a positive number of Hz, got {a.turn_cutoff_hz:g}")
     if a.urdf:

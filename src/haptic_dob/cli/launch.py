@@ -1,27 +1,15 @@
 """``haptic-launch``: bring up a session's node graph from one ``ros__parameters`` YAML.
 
-Every node section of the YAML (``device_node``, ``environment_node``, ``observer_node``,
-``controller_node``, ``recorder_node``) starts through the ``ros2 run`` contract
-(``<prefix>/lib/<pkg>/<exe>`` found with ``ament_index_python``), with
-``--ros-args --params-file CONFIG`` and the namespace. Composition groups say which nodes share a
-process (``<prefix>/lib/haptic_dob/container``, where the loop's messages are handed over in
-process): by default the loop (device, environment, observer, controller) shares one and a
-recorder runs apart; ``--processes`` gives every node its own, ``--composed`` puts all in one,
-``--group`` names groups. The device's process starts last. Ctrl-C or SIGTERM is forwarded to
-every process as SIGTERM (each shuts down cleanly: the device zeroes its effort; a node still
-starting up ends quietly, with no Python traceback as SIGINT would give) and the launcher waits
-for them, killing what is still alive after ``--stop-timeout``. When the device finishes a
-lockstep run (``duration_s``) the others are stopped too.
-
-Network: by default every node's discovery stays on this host
-(``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), so a simulated session never reaches a lab network
-by accident. ``--network subnet`` lets them discover across the subnet, ``--peers`` adds named
-hosts (``ROS_STATIC_PEERS``), and ``--only`` starts a subset: the device on one host and the rest
-on another (see docs/running.md, "Lab network and security").
-
-A teleoperation YAML (``/master/...`` and ``/slave/...`` sections) starts the two sides' nodes in
-their namespaces, all in one process by default; ``--group`` and ``--only`` take sides there
-(``haptic_dob.launcher.teleop``).
+Each node section starts through the ``ros2 run`` contract (``<prefix>/lib/<pkg>/<exe>`` found
+with ``ament_index_python``) with ``--ros-args --params-file CONFIG`` and the namespace. By
+default the loop (device, environment, observer, controller) shares one process and a recorder
+runs apart; ``--processes``, ``--composed`` and ``--group`` choose otherwise. The device's
+process starts last. Ctrl-C or SIGTERM goes to every process as SIGTERM, what is alive after
+``--stop-timeout`` is killed, and the end of a lockstep run (``duration_s``) stops the others.
+Discovery stays on this host unless ``--network subnet`` (``--peers``: named hosts; ``--only``:
+a subset). A device and its controller started together share a fresh ``command_token``; the
+launch says it, and the domain and discovery range. A teleoperation YAML (``/master/...``,
+``/slave/...`` sections): ``haptic_dob.launcher.teleop``. Guide: docs/running.md.
 """
 
 from __future__ import annotations
@@ -31,7 +19,9 @@ import tempfile
 from pathlib import Path
 
 from haptic_dob.cli.common import ArgumentParser, run
+from haptic_dob.launcher import robot_description
 from haptic_dob.launcher.node_params import (
+    add_command_tokens,
     add_cpu_latency,
     add_pinning,
     add_recorder,
@@ -45,6 +35,7 @@ from haptic_dob.launcher.options import (
     network_env,
     normalize_namespace,
     parse_sets,
+    say_session,
 )
 from haptic_dob.launcher.process_plan import check_pinnable, groups_for, plan, select
 from haptic_dob.launcher.supervise import check_cpu_latency_request, launch, set_rt_priority
@@ -63,6 +54,11 @@ def command(opts: LaunchOptions) -> int:
         return teleop_command(opts, load_teleop_sections(path))
     namespace = normalize_namespace(opts.namespace)
     params = resolved_params(path, parse_sets(opts.sets))
+    if opts.robot_description:
+        urdf = robot_description.fetch(
+            opts.robot_description, network_env(opts.network, opts.peers)
+        )
+        robot_description.fill(params, urdf)
     if opts.record:
         add_recorder(params, opts.record, opts.record_storage)
     names = select([n for n in START_ORDER if n in params], opts.only)
@@ -78,6 +74,7 @@ def command(opts: LaunchOptions) -> int:
         set_rt_priority(opts.rt_priority)
     if opts.executor:
         net["HAPTIC_DOB_EXECUTOR"] = opts.executor
+    say_session(net, add_command_tokens(params, names))
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
         chosen = {n: v for n, v in params.items() if n == "/**" or n in names}
         specs = plan(chosen, write_params_file(params, Path(tmp)), namespace, groups)
@@ -184,6 +181,12 @@ def build_parser() -> ArgumentParser:
         "poll, which speeds up every hand-over (BENCHMARKS.md) and costs power; on a virtual "
         "machine only 0 helps",
     )
+    p.add_argument(
+        "--robot-description",
+        metavar="TOPIC",
+        help="read the URDF a driver latches on TOPIC (robot_state_publisher's "
+        "robot_description) and give it to every node whose model is urdf",
+    )
     return p
 
 
@@ -208,6 +211,7 @@ def parse_options(argv: list[str] | None = None) -> LaunchOptions:
         rt_priority=a.rt_priority,
         pin=a.pin,
         cpu_latency_us=a.cpu_latency,
+        robot_description=a.robot_description,
     )
 
 

@@ -6,9 +6,10 @@ are every session topic and ``/parameter_events``; a snapshot of every node's pa
 namespace goes into the bag too. Start it before the device in lockstep and add its node name to
 the device's ``wait_for`` so the run waits for it and nothing is lost.
 
-The recorder puts what it wrote into complete records on disk at least once a second; after a
-kill -9, a crash or a power cut, ``haptic-record --recover BAG`` writes what is complete (all but
-at most the last second) to a new bag that every tool opens.
+The recorder puts what it wrote into complete records on disk whenever a topic's stamps advanced
+a second of session time; after a kill -9, a crash or a power cut, ``haptic-record --recover
+BAG`` writes what is complete (all but at most the last second of session time of each topic) to
+a new bag that every tool opens, and says where each topic ends.
 """
 
 from __future__ import annotations

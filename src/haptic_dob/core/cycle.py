@@ -4,8 +4,7 @@ Batch runs and the node graph run the same three stages in the same order, so a 
 reproduces a batch run bit for bit:
 
 1. ``wall_force``: the virtual environment's force from the end-effector pose and twist of
-   sample k, plus a known excitation at the sample's time along the wall normal (environment
-   node);
+   sample k, plus a known excitation at the sample's time (environment node);
 2. ``estimate``: the observer updated with sample k (positions, velocities, the effort applied
    over [k-1, k)) and its wrench at the end effector (observer node);
 3. ``CommandJoin`` (``haptic_dob.core.command_join``): command k from the stamp-k inputs the law's
@@ -34,13 +33,13 @@ def wall_force(
     stamp_ns: int = 0,
 ) -> Force:
     """Stage 1: the wall's force on the hand (N) at the sample's end-effector point and twist,
-    plus ``excitation`` at the sample's time along the wall normal."""
+    plus ``excitation`` at the sample's time (along the wall normal or per axis, and its holding
+    spring)."""
     f = wall.force(position, velocity)  # type: ignore[arg-type]  # 3-sequences of floats
     if excitation is None:
         return f
-    e = excitation.force_n(stamp_ns * 1e-9)
-    n = wall.normal
-    return (f[0] + e * n[0], f[1] + e * n[1], f[2] + e * n[2])
+    e = excitation.force(stamp_ns * 1e-9, wall.normal, position)
+    return (f[0] + e[0], f[1] + e[1], f[2] + e[2])
 
 
 def estimate(

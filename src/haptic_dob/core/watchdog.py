@@ -1,10 +1,10 @@
 """The watchdog, counted in samples: the real-time device's (zero effort when valid commands stop)
 and each end of the teleoperation channel's (``haptic_dob.teleop.delay``: a silent peer).
 
-The simulated plant moves only when the device ticks, so the watchdog counts the plant's samples,
-not the wall clock: a stall of the device's own process (the host, the garbage collector) never
-trips it, while a silent controller trips it within the timeout of the plant's time however late
-or bunched the ticks come. The next valid command resumes the effort.
+The device's watchdog counts the samples the device sent, not the wall clock: a stall of the
+device's own process (the host, the garbage collector: an overrun of its ticks) never trips it,
+while a silent controller trips it within the timeout's samples however late or bunched the ticks
+come. The next valid command resumes the effort.
 """
 
 from __future__ import annotations

@@ -9,6 +9,7 @@ runs, the tests) imports from here.
 """
 
 from haptic_dob.launcher.node_params import (
+    add_command_tokens,
     add_cpu_latency,
     add_pinning,
     add_recorder,
@@ -25,6 +26,7 @@ __all__ = [
     "START_ORDER",
     "LaunchOptions",
     "ProcessSpec",
+    "add_command_tokens",
     "add_cpu_latency",
     "add_pinning",
     "add_recorder",

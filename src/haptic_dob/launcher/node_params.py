@@ -1,24 +1,31 @@
 """The nodes' parameter table of one launch: the config's node sections with ``--set`` applied,
-what ``--record``, ``--pin`` and ``--cpu-latency`` add, and the params file every node reads.
+what ``--record``, ``--pin`` and ``--cpu-latency`` add, the session's command token, and the
+params file every node reads.
 
 The table maps a node's name (or ``/**``, every node) to its flat ``{param: value}``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from haptic_dob.core.command_authority import new_token
 from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import NODES
+from haptic_dob.runtime.configs import urdf_beside
 from haptic_dob.runtime.params import load_node_params
 
 
 def resolved_params(config: Path, sets: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """The config's node sections (flattened, ``--set`` applied), keyed by node name."""
+    """The config's node sections (flattened, ``--set`` applied), keyed by node name; a
+    relative ``urdf_path`` is taken from the config's directory where the file is there
+    (``urdf/fd_cartesian.urdf`` beside an installed config)."""
     out = load_node_params(config)
+    urdf_beside(out, config)
     unknown = [n for n in out if n != "/**" and n not in NODES]
     if unknown:
         raise InputError(
@@ -36,7 +43,8 @@ def add_recorder(params: dict[str, Any], output: str, storage: str) -> None:
             f"--record {output}: it exists already; the recorder never overwrites a bag"
         )
     params.setdefault("recorder_node", {}).update(output=output, storage=storage)
-    device = params.setdefault("device_node", {})
+    # the node that starts the loop waits for it: the bridge to a driver, or the device
+    device = params.setdefault("bridge_node" if "bridge_node" in params else "device_node", {})
     wait = list(device.get("wait_for", ["environment_node", "observer_node", "controller_node"]))
     if "recorder_node" not in wait:
         device["wait_for"] = [*wait, "recorder_node"]
@@ -76,6 +84,47 @@ def add_cpu_latency(params: dict[str, Any], latency_us: int) -> None:
     for name in (n for pair in PAIRS for n in pair if n in params):
         if params[name].get("cpu_latency_us", common) in (None, NO_REQUEST):
             params[name]["cpu_latency_us"] = latency_us
+
+
+#: the nodes that take ``effort_command`` at a device end (the device bridge is one too)
+DEVICE_ENDS = ("device_node", "bridge_node")
+DEFAULT_SOURCE = "controller_node"
+
+
+def add_command_tokens(params: dict[str, Any], started: Sequence[str]) -> list[str]:
+    """One fresh command token for every device end in ``started`` and its ``command_source``,
+    when that starts too and no token was given (config, ``--set``); what each device end takes
+    its commands by, a line each. Names may carry a namespace (``slave/device_node``), where the
+    source is looked for beside the device end."""
+    common = params.get("/**", {})
+    token = new_token()
+    lines = []
+    for name in started:
+        ns, _, node = name.rpartition("/")
+        if node not in DEVICE_ENDS:
+            continue
+        values = params.setdefault(name, {})
+
+        def given(key: str, default: Any, values: dict[str, Any] = values) -> Any:
+            return values.get(key, common.get(key, default))
+
+        source = given("command_source", DEFAULT_SOURCE)
+        source_key = f"{ns}/{source}" if ns else source
+        if given("open_command_input", False):
+            how = "from any publisher (open_command_input)"
+        elif given("command_token", ""):
+            how = f"only from {source}, by the command_token given"
+        elif source_key in started:
+            values["command_token"] = token
+            params.setdefault(source_key, {})["command_token"] = token
+            how = f"only from {source}, by this launch's command token"
+        else:
+            how = (
+                f"only from {source}, which starts elsewhere: by its node name and GID in the "
+                "graph (give both the same command_token to check every command)"
+            )
+        lines.append(f"{name} takes effort_command {how}")
+    return lines
 
 
 def write_params_file(params: dict[str, Any], directory: Path) -> Path:

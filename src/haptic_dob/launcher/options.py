@@ -1,9 +1,12 @@
 """What ``haptic-launch`` is asked for (``LaunchOptions``) and the checks that turn option values
-into launch inputs: the namespace, the ``--set`` overrides, the discovery environment."""
+into launch inputs: the namespace, the ``--set`` overrides, the discovery environment (and the
+line that says which domain and range the nodes get)."""
 
 from __future__ import annotations
 
+import os
 import re
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -12,6 +15,7 @@ import yaml
 
 from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import NODES
+from haptic_dob.runtime.discovery import Discovery
 
 
 @dataclass(frozen=True)
@@ -35,6 +39,7 @@ class LaunchOptions:
     rt_priority: int | None = None
     pin: bool = False
     cpu_latency_us: int | None = None
+    robot_description: str | None = None
 
 
 def comma_list(text: str) -> tuple[str, ...]:
@@ -101,3 +106,11 @@ def network_env(network: str, peers: Sequence[str]) -> dict[str, str]:
             raise InputError("--peers needs --network subnet (peers are other hosts)")
         env["ROS_STATIC_PEERS"] = ";".join(peers)
     return env
+
+
+def say_session(net: dict[str, str], authority: Sequence[str]) -> None:
+    """Print (stderr) the DDS domain and discovery range the nodes get (``net`` over this
+    process's environment), then how each device takes its commands (``authority``)."""
+    print(f"haptic-launch: {Discovery.of({**os.environ, **net}).describe()}", file=sys.stderr)
+    for line in authority:
+        print(f"haptic-launch: {line}", file=sys.stderr)

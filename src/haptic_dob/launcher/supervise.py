@@ -65,7 +65,8 @@ def launch(
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     procs: dict[str, subprocess.Popen[bytes]] = {}
     labels = {s.name: s.label for s in specs}
-    devices = {s.name for s in specs if any(n.rsplit("/", 1)[-1] == "device_node" for n in s.nodes)}
+    ends = ("device_node", "bridge_node")  # a device's lockstep run, a bridge's duration_s
+    devices = {s.name for s in specs if any(n.rsplit("/", 1)[-1] in ends for n in s.nodes)}
     code = 0
     try:
         for spec in specs:
@@ -88,7 +89,7 @@ def launch(
                 break
             if done and devices <= set(done):  # every device finished its run (a teleop: two)
                 print(
-                    "haptic-launch: device_node finished its run; stopping the graph",
+                    "haptic-launch: the device (or bridge) finished its run; stopping the graph",
                     file=sys.stderr,
                 )
                 break

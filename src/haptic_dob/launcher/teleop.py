@@ -4,16 +4,14 @@ namespaces (``haptic_dob.teleop.graph``), all in one process by default.
 A YAML with ``/master/...`` or ``/slave/...`` sections is a teleoperation graph: each node's
 parameters are its sections overlaid (``node_values``), written to a params file under the
 node's full name; ``--set NS/NODE:PARAM=VALUE`` overrides one node's, ``**/NODE:`` the node of
-both sides. ``--composed`` (the default) runs all nodes in one container (every message, the
-channel's link too, handed over in process; a stall stops both sides alike), ``--processes`` one
+both sides. ``--composed`` (the default) runs all nodes in one container, ``--processes`` one
 process each, ``--group`` names groups (``master``, ``slave`` or ``NS/NODE`` items: ``--group
 master --group slave`` gives each side a process and each device a CPU; the devices'
-``start_with`` starts their clocks together). ``--only`` starts the named sides or nodes: the
-slave on another host, with ``--network subnet``. ``--record BAG`` adds a ``recorder_node`` in
-the root namespace, in a process of its own: it records both sides' topics and the channel's
-(``recorded_topics``), snapshots the nodes of ``/master`` and ``/slave``, and both devices wait
-for it (``haptic-teleop --bag BAG`` analyses the bag). The options of a single loop's launch
-``--namespace``, ``--pin`` and ``--cpu-latency`` are refused.
+``start_with`` starts their clocks together). ``--only`` starts the named sides or nodes (the
+slave on another host, with ``--network subnet``). ``--record BAG`` adds a ``recorder_node`` in
+the root namespace, in a process of its own, recording both sides' and the channel's topics
+(``recorded_topics``) and snapshotting ``/master`` and ``/slave``; both devices wait for it.
+``--namespace``, ``--pin`` and ``--cpu-latency`` are refused. Guide: docs/teleoperation.md.
 """
 
 from __future__ import annotations
@@ -27,8 +25,10 @@ from typing import Any
 import yaml
 
 from haptic_dob.errors import InputError
-from haptic_dob.launcher.options import LaunchOptions, network_env
+from haptic_dob.launcher.node_params import add_command_tokens
+from haptic_dob.launcher.options import LaunchOptions, network_env, say_session
 from haptic_dob.launcher.process_plan import ProcessSpec, executable
+from haptic_dob.launcher.robot_description import fetch, fill
 from haptic_dob.launcher.supervise import launch, set_rt_priority
 from haptic_dob.nodes.registry import CONTAINER, NODES
 from haptic_dob.teleop.graph import (
@@ -36,10 +36,14 @@ from haptic_dob.teleop.graph import (
     RECORDER,
     SIDE_NODES,
     check_sections,
+    device_of,
     graph_nodes,
     node_values,
     recorded_topics,
 )
+
+#: the slave device's commands come from its slave controller
+SLAVE_SOURCE = "slave_controller_node"
 
 
 def teleop_params(
@@ -47,12 +51,13 @@ def teleop_params(
 ) -> dict[str, dict[str, Any]]:
     """``{"master/device_node": {param: value}, ...}`` for every node, ``--set`` applied; a side
     whose device runs in real time gets ``wait_for_peer: false`` on its channel end unless given
-    (waiting for the peer's messages is lockstep's)."""
+    (waiting for the peer's messages is lockstep's), and the slave's device end (its device or
+    bridge) takes its commands from the slave controller unless told otherwise."""
     try:
         check_sections(sections)
     except ValueError as exc:
         raise InputError(str(exc)) from None
-    out = {f"{ns}/{node}": node_values(sections, ns, node) for ns, node in graph_nodes()}
+    out = {f"{ns}/{node}": node_values(sections, ns, node) for ns, node in graph_nodes(sections)}
     for item in sets:
         target, sep, assignment = item.partition(":")
         param, eq, text = assignment.partition("=")
@@ -71,8 +76,10 @@ def teleop_params(
         for name in names:
             out[name][param] = value
     for ns in NAMESPACES:  # a real-time side's channel end uses what has come (no lockstep wait)
-        if out[f"{ns}/device_node"].get("clock_mode") == "realtime":
+        device = device_of(sections, ns)  # a bridge to a driver is real time
+        if device != "device_node" or out[f"{ns}/{device}"].get("clock_mode") == "realtime":
             out[f"{ns}/channel_node"].setdefault("wait_for_peer", False)
+    out[f"slave/{device_of(sections, 'slave')}"].setdefault("command_source", SLAVE_SOURCE)
     return out
 
 
@@ -102,10 +109,13 @@ def add_teleop_recorder(params: dict[str, dict[str, Any]], output: str, storage:
         "storage": storage,
         "topics": recorded_topics(),
         "namespaces": [f"/{ns}" for ns in NAMESPACES],
-        "rate_hz": params["master/device_node"].get("rate_hz", 1000.0),
+        "rate_hz": params.get("master/device_node", params.get("master/bridge_node", {})).get(
+            "rate_hz", 1000.0
+        ),
     }
     for ns in NAMESPACES:
-        device = params[f"{ns}/device_node"]
+        name = f"{ns}/device_node" if f"{ns}/device_node" in params else f"{ns}/bridge_node"
+        device = params[name]
         default = [n for n in SIDE_NODES[ns] if n != "device_node"]
         device["wait_for"] = [*device.get("wait_for", default), RECORDER]
 
@@ -194,6 +204,9 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
             "/master and /slave)"
         )
     params = teleop_params(sections, opts.sets)
+    if opts.robot_description:
+        env = network_env(opts.network, opts.peers)
+        fill(params, fetch(opts.robot_description, env))
     names = select_nodes([n for n in params if "/" in n], opts.only)
     groups = teleop_groups(names, opts.composed, opts.processes, opts.groups)
     if opts.record and opts.only:
@@ -209,6 +222,7 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
         set_rt_priority(opts.rt_priority)
     if opts.executor:
         net["HAPTIC_DOB_EXECUTOR"] = opts.executor
+    say_session(net, add_command_tokens(params, names))
     with tempfile.TemporaryDirectory(prefix="haptic-launch-") as tmp:
         specs = teleop_plan(params, write_teleop_params(params, Path(tmp)), groups)
         for spec in specs:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 from haptic_dob.runtime.params import ParamSpec
 from haptic_msgs_py.topics import DEFAULT_BASE_FRAME, INPUT_RELIABILITY
 
@@ -37,6 +39,52 @@ def input_specs(default: str) -> list[ParamSpec]:
             read_only=True,
         )
     ]
+
+
+def command_authority_specs() -> list[ParamSpec]:
+    """Who may command a device end (the simulated device node, the device bridge): the command
+    source, the session's token, the bench switch (``haptic_dob.core.command_authority``)."""
+    return [
+        ParamSpec(
+            "command_source",
+            "controller_node",
+            "the node whose effort_command moves the device from another process: a name in "
+            "this namespace, or fully qualified (commands handed over in this process, the loop "
+            "composed, always do)",
+            read_only=True,
+        ),
+        ParamSpec(
+            "command_token",
+            "",
+            "this session's command token: a command from another process moves the device only "
+            "when its layout label carries it (effort@<stamp>#<token>); haptic-launch writes a "
+            "fresh one for a device and its controller at every launch. '' = the token of "
+            "command_source's commands, taken while the graph shows that node (name and GID) as "
+            "the only publisher. Not a secret from anyone on the network (docs/safety.md)",
+            read_only=True,
+        ),
+        ParamSpec(
+            "open_command_input",
+            False,
+            "take effort_command from any publisher (bench work: ros2 topic pub, a tool of your "
+            "own); false: only command_source's, the others refused, counted in /diagnostics and "
+            "named once each in the log. At start-up only: no one on the network can open it "
+            "with ros2 param set",
+            read_only=True,
+        ),
+    ]
+
+
+def command_token_spec() -> ParamSpec:
+    """The token a command source's ``effort_command`` carries (the controllers)."""
+    return ParamSpec(
+        "command_token",
+        "",
+        "the token this node's effort_command carries in its layout label "
+        "(effort@<stamp>#<token>), by which the device takes commands from another process; "
+        "haptic-launch writes the session's; '' = a fresh random one at every start",
+        read_only=True,
+    )
 
 
 def process_specs() -> list[ParamSpec]:
@@ -141,3 +189,17 @@ def main_for(node_class: type, args: list[str] | None, specs: list[ParamSpec]) -
 
     ensure_ament_prefix()
     return run_nodes(lambda ctx: [node_class(context=ctx)], argv)
+
+
+def missing_nodes(
+    wait_for: Iterable[str], graph: Iterable[tuple[str, str]], namespace: str
+) -> list[str]:
+    """The ``wait_for`` entries that are not up in ``graph`` ((name, namespace) of each node): a
+    plain name is a node of ``namespace``, one starting with ``/`` a fully qualified name (a
+    recorder elsewhere, such as ``ros2 bag record``'s ``/rosbag2_recorder``)."""
+    here, everywhere = set(), set()
+    for name, space in graph:
+        everywhere.add(f"{space.rstrip('/')}/{name}")
+        if space == namespace:
+            here.add(name)
+    return [w for w in wait_for if w not in (everywhere if w.startswith("/") else here)]

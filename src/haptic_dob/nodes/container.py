@@ -1,11 +1,13 @@
-"""``ros2 run haptic_dob container NODE [NODE ...] --ros-args ...``: several nodes, one process.
+"""``ros2 run haptic_dob container [NODE ...] --ros-args ...``: several nodes, one process.
 
 The nodes are the same nodes as their own executables start (parameters, services, diagnostics,
 topics), with their default names, under one executor; the loop's messages between them are
 handed over in process (``haptic_msgs_py.bus``) and reach DDS only for readers elsewhere.
 ``--ros-args`` apply to every node (a params file keyed by node name, ``-r __ns:=``; not
 ``__node``, which would give them all one name). A node named ``NS/NODE`` runs in namespace
-``/NS`` (a teleoperation graph: ``master/device_node slave/device_node ...``).
+``/NS`` (a teleoperation graph: ``master/device_node slave/device_node ...``). Without names the
+container runs the nodes its ``--params-file`` sections name (``ros_args.configured_nodes``; a
+recorder only when named).
 """
 
 from __future__ import annotations
@@ -13,10 +15,12 @@ from __future__ import annotations
 import sys
 
 from haptic_dob.nodes.registry import NODES, START_ORDER, node_class
+from haptic_dob.runtime.ros_args import configured_nodes
 
 USAGE = (
-    "usage: container NODE [NODE ...] [--ros-args ...]\n"
-    "Runs the named nodes in this one process (nodes: " + ", ".join(NODES) + ")."
+    "usage: container [NODE ...] [--ros-args [--params-file FILE] ...]\n"
+    "Runs the named nodes in this one process (nodes: " + ", ".join(NODES) + "); without names,\n"
+    "the nodes the params files' sections name (a recorder only when named)."
 )
 
 
@@ -31,7 +35,12 @@ def parse(argv: list[str]) -> tuple[list[str], list[str]]:
     split = argv.index("--ros-args") if "--ros-args" in argv else len(argv)
     names, ros_args = argv[:split], argv[split:]
     if not names:
-        raise ValueError("name at least one node to run")
+        names = configured_nodes(ros_args, [n for n in NODES if n != "recorder_node"])
+    if not names:
+        raise ValueError(
+            "name at least one node to run, or give a --params-file whose sections name them "
+            "(after --ros-args)"
+        )
     unknown = [n for n in names if split_name(n)[1] not in NODES]
     if unknown:
         raise ValueError(f"unknown node(s) {', '.join(unknown)}; nodes: {', '.join(NODES)}")

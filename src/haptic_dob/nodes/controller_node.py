@@ -3,7 +3,8 @@
 Inputs: ``wrench_desired`` (the wall), ``joint_states`` (for J(q); not subscribed when the model's
 Jacobian is constant, as on the slide), and, as the mode needs them, ``wrench_measured`` (CL) or
 ``wrench_estimate`` (DOB). Command k goes out as soon as every input
-of stamp k the mode needs has arrived, labelled with its stamp (``effort@<ns>``). ``mode``, ``kf``
+of stamp k the mode needs has arrived, labelled with its stamp and the session's command token
+(``effort@<ns>#<token>``: the device takes commands from another process by it). ``mode``, ``kf``
 and ``max_force_n`` change at run time: the next command uses the new law, with no other state to
 carry (bumpless). A switch to CL or DOB is refused while its force input is not flowing (the
 observer must be warm before DOB takes over).
@@ -30,11 +31,18 @@ from typing import Any
 
 from rclpy.context import Context
 
+from haptic_dob.core.command_authority import new_token
 from haptic_dob.core.command_join import FALLBACKS, CommandJoin
 from haptic_dob.core.control import HandForce, ImpedanceController, ImpedanceLaw
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
+from haptic_dob.nodes.common import (
+    command_token_spec,
+    input_specs,
+    loop_specs,
+    main_for,
+    process_specs,
+)
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
@@ -58,6 +66,7 @@ def controller_node_specs() -> list[ParamSpec]:
     return [
         *loop_specs(),
         *input_specs("best_effort"),
+        command_token_spec(),
         *process_specs(),
         *model_specs(),
         *specs_of(ImpedanceLaw),
@@ -122,6 +131,7 @@ class ControllerNode(LoopNode):
         self._pending_since = 0.0
         self._warned_ns = -1
         self._last: EffortCommand | None = None
+        self._token = values["command_token"] or new_token()
         self._pub = LoopPublisher(self, EFFORT_COMMAND, codecs.EFFORT, qos.LOOP)
         inputs: list[tuple[str, codecs.Codec, Any]] = [
             (WRENCH_DESIRED, codecs.WRENCH, self._on_desired)
@@ -198,7 +208,7 @@ class ControllerNode(LoopNode):
             return
         last = self._last
         if last is None or last.stamp_ns != self.join.sent_ns:
-            last = self._last = EffortCommand(self.join.sent_ns, tuple(command))
+            last = self._last = EffortCommand(self.join.sent_ns, tuple(command), self._token)
             self.diagnostics.tick()
         self._pub.publish(last)  # a repeated sample gets the same command again
 

@@ -30,6 +30,11 @@ def slave_controller_node() -> int:
     return run_main("haptic_dob.nodes.slave_controller_node")
 
 
+def bridge_node() -> int:
+    """``haptic-bridge-node``."""
+    return run_main("haptic_dob.nodes.bridge_node")
+
+
 def recorder_node() -> int:
     """``haptic-recorder-node``."""
     return run_main("haptic_dob.nodes.recorder_node")

@@ -1,8 +1,11 @@
 """environment_node: the virtual wall. ee_pose + ee_twist of sample k -> wrench_desired k.
 
 The wall (``stiffness_n_per_m``, ``damping_n_s_per_m``, ``position``, ``normal``, ``two_sided``)
-and a known force it adds along its normal at the sample's time (``excitation.*``: a step or a
-sine, the identification experiment's input) change at run time.
+and a known force it adds at the sample's time (``excitation.*``: a step or a sine along its
+normal, a chirp or a multisine along it or along each axis, and a holding spring: the
+identification experiment's input) change at run time. The sample's time counts from the first
+sample the node rendered: sample 0 in lockstep (stamp 0), and in real time, where a stamp is the
+system clock's, the first that came (a restarted node starts its excitation anew).
 """
 
 from __future__ import annotations
@@ -64,6 +67,7 @@ class EnvironmentNode(LoopNode):
         self._twist: StampedVector | None = None
         self._period_ns = period_ns(self.params.values["rate_hz"])
         self._emitted_ns = -1  # stamp of the newest wall force
+        self._origin_ns: int | None = None  # stamp of the first sample rendered: time 0
         self._pub = LoopPublisher(
             self, WRENCH_DESIRED, codecs.WRENCH, qos.LOOP, self.params.values["base_frame"]
         )
@@ -113,8 +117,12 @@ class EnvironmentNode(LoopNode):
             self._emit(pose, twist)
 
     def _emit(self, pose: StampedVector, twist: StampedVector) -> None:
-        self._emitted_ns = pose.stamp_ns
-        force = wall_force(self.wall, pose.vector, twist.vector, self._adds, pose.stamp_ns)
+        self._emitted_ns = stamp = pose.stamp_ns
+        if self._origin_ns is None:
+            self._origin_ns = stamp
+        force = wall_force(
+            self.wall, pose.vector, twist.vector, self._adds, stamp - self._origin_ns
+        )
         self._pub.publish(StampedVector(pose.stamp_ns, force))
         self.diagnostics.tick()
 

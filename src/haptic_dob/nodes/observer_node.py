@@ -57,7 +57,7 @@ class ObserverNode(LoopNode):
         self.observer = self._make_observer(self.params.settings)
         self.joints = JointMap(self.model.joint_names)
         self._last_ns = -1
-        self.gaps = 0  # samples that came more than one period after the previous one
+        self.gaps = 0  # samples that came two periods or more after the previous one
         self._prev_q: list[float] | None = None
         self._bad_input_logged = ""
         self._force: Force = ZERO_FORCE
@@ -137,14 +137,16 @@ class ObserverNode(LoopNode):
         except ValueError as exc:
             self._complain(str(exc))
             return
-        jump = (now - self._last_ns) / self.period_ns if self._last_ns >= 0 else 1.0
+        # periods since the previous sample: a real-time device's stamps (the system clock when
+        # each sample was taken) are a period apart give or take its wake-up jitter
+        jump = round((now - self._last_ns) / self.period_ns) if self._last_ns >= 0 else 1
         self._prev_q = q
         self._last_ns = now
         self._bad_input_logged = ""
         self._force = estimate(self.observer, q, qd, tau)
         self._publish(now)  # the estimate first, then what is said of it
         self.diagnostics.tick()
-        if jump != 1.0:
+        if jump > 1:
             self.gaps += 1
             self.log.warning(
                 f"joint_states jumped {jump:g} periods ({self.gaps} gaps so far); the update "

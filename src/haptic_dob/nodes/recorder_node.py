@@ -9,6 +9,8 @@
 - Publishes ``recorder/progress`` (``std_msgs/Header``: newest stamp written over the flowing
   topics, its name in ``frame_id``) at ``progress_rate_hz``: a lockstep device holds the loop
   while that lags, and sends sample 0 only once every reader matched, so nothing is lost.
+  Volatile, so a late ``ros2 topic echo`` is told of no loss (docs/recording-and-analysis.md).
+- Stores each topic's offered QoS (from the graph) in the bag, as ``ros2 bag record`` does.
 - On SIGINT/SIGTERM (or after ``duration_s``) takes what is still queued (at most
   ``drain_timeout_s``), closes the bag readable and logs per topic what it received and wrote.
 
@@ -24,6 +26,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 from rcl_interfaces.srv import GetParameters, ListParameters
+from rclpy._rclpy_pybind11 import InvalidHandle, RCLError
 from rclpy.client import Client
 from rclpy.context import Context
 from rclpy.parameter import parameter_value_to_python
@@ -34,9 +37,11 @@ from rclpy.qos import (
     ReliabilityPolicy,
     qos_profile_parameter_events,
 )
+from rosbags.interfaces import Qos
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Header
 
+from haptic_dob.bag.jazzy import offered_qos
 from haptic_dob.nodes.common import main_for
 from haptic_dob.recorder.drain import take_until_quiet
 from haptic_dob.recorder.matching import ReaderMatch, reported_progress
@@ -53,9 +58,9 @@ from haptic_msgs_py.topics import CLOCK
 
 PROGRESS_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
-    depth=1,
+    depth=10,  # a report lost on the way is repaired, not counted lost by a reliable reader
     reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    durability=DurabilityPolicy.VOLATILE,
 )
 SUBSCRIPTION_QOS = {
     TopicKind.EVENTS: qos_profile_parameter_events,
@@ -85,9 +90,8 @@ class RecorderNode(LoopNode):
                 classes[t.typename] = rclpy_type(t.typename)
             except (ImportError, AttributeError, ValueError):
                 raise ValueError(f"topics: {t.typename} is not an installed message type") from None
-        self.recording = Recording(
-            new_bag_path(v["output"]), v["storage"], period_ns(v["rate_hz"]), v["log_time"]
-        )
+        path, period = new_bag_path(v["output"]), period_ns(v["rate_hz"])
+        self.recording = Recording(path, v["storage"], period, v["log_time"], self._offered_qos)
         self._t_end = time.monotonic() + v["duration_s"] if v["duration_s"] > 0 else None
         self._subs: list[tuple[Any, Callable[[bytes], None]]] = []
         kinds = [t.kind(self.resolve_topic_name(t.name)) for t in topics]
@@ -119,6 +123,13 @@ class RecorderNode(LoopNode):
             f"recording {len(topics)} topic(s) to {self.recording.path} ({self.recording.storage})"
         )
 
+    def _offered_qos(self, topic: str) -> list[Qos]:
+        """The QoS profiles the publishers of ``topic`` offer, as the graph reports them."""
+        try:
+            return [offered_qos(i.qos_profile) for i in self.get_publishers_info_by_topic(topic)]
+        except (RCLError, InvalidHandle):  # the context is going away: the bag still closes
+            return []
+
     # --- progress --------------------------------------------------------------------------
     def progress_ns(self) -> int:
         """Newest stamp written (ns), minimum over the stamped topics that are flowing."""
@@ -144,7 +155,7 @@ class RecorderNode(LoopNode):
         self._progress_msg.stamp.sec, self._progress_msg.stamp.nanosec = sec, nsec
         for pub in self._progress:
             pub.publish(self._progress_msg)
-        self.recording.keep_durable()  # at least once a second: a kill -9 loses at most that
+        self.recording.keep_durable()  # while no message comes: once a second of wall time
 
     def _on_clock(self, msg: Clock) -> None:
         self.recording.observe_clock(msg.clock.sec * NS_PER_S + msg.clock.nanosec)

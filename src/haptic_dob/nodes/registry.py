@@ -21,7 +21,8 @@ class NodeEntry(NamedTuple):
     cls: str
 
 
-#: the order nodes start in: a recorder first, the device (which waits for the rest) last
+#: the order nodes start in: a recorder first, the device or the bridge to a driver (which waits
+#: for the rest) last
 START_ORDER = (
     "recorder_node",
     "environment_node",
@@ -29,6 +30,7 @@ START_ORDER = (
     "controller_node",
     "channel_node",
     "slave_controller_node",
+    "bridge_node",
     "device_node",
 )
 
@@ -50,8 +52,9 @@ def _registered() -> dict[str, NodeEntry]:
 
 NODES: dict[str, NodeEntry] = _registered()
 
-#: the nodes that close the loop: composed in one process by default (``haptic-launch``)
-LOOP_NODES = ("device_node", "environment_node", "observer_node", "controller_node")
+#: the nodes that close the loop: composed in one process by default (``haptic-launch``); a
+#: foreign driver's bridge takes the simulated device's place (the driver is its own process)
+LOOP_NODES = ("device_node", "bridge_node", "environment_node", "observer_node", "controller_node")
 
 #: the executable that hosts several nodes in one process (``ros2 run haptic_dob container``)
 CONTAINER = ("haptic_dob", "container")

@@ -4,7 +4,8 @@ k -> effort_command k.
 Runs ``haptic_dob.teleop.slave.SlaveController``: a differential-IK step moves the joint target
 toward ``pose_desired`` (the point the channel's slave end wants the tool at), and the joint
 impedance around it plus the model's gravity gives the efforts, saturated at the model's limits.
-Command k goes out once both inputs of stamp k are here, labelled with the stamp; a sample
+Command k goes out once both inputs of stamp k are here, labelled with the stamp and the
+session's command token (``command_token``, as the controller node's); a sample
 answered already is answered again with the same command (a lockstep re-send). The gains are
 set at the first sample's pose (``slave.*``, read-only).
 """
@@ -16,9 +17,16 @@ import sys
 import numpy as np
 from rclpy.context import Context
 
+from haptic_dob.core.command_authority import new_token
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
+from haptic_dob.nodes.common import (
+    command_token_spec,
+    input_specs,
+    loop_specs,
+    main_for,
+    process_specs,
+)
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
@@ -36,6 +44,7 @@ def slave_controller_node_specs() -> list[ParamSpec]:
     return [
         *loop_specs(),
         *input_specs("best_effort"),
+        command_token_spec(),
         *process_specs(),
         *model_specs(),
         *specs_of(SlaveImpedance, "slave.", read_only=True),
@@ -62,6 +71,7 @@ class SlaveControllerNode(LoopNode):
         self._q: tuple[int, list[float], list[float]] | None = None
         self._target: StampedVector | None = None
         self._last: EffortCommand | None = None
+        self._token = v["command_token"] or new_token()
         self._pub = LoopPublisher(self, EFFORT_COMMAND, codecs.EFFORT, qos.LOOP)
         inputs = qos.loop_input(v["input_reliability"])
         LoopSubscription(self, JOINT_STATES, codecs.JOINT_STATE, self._on_joints, inputs)
@@ -96,7 +106,7 @@ class SlaveControllerNode(LoopNode):
             return
         _, q, qd = joints
         tau = self.controller.command(np.asarray(q), np.asarray(qd), target.vector)
-        self._last = EffortCommand(k, tuple(tau))
+        self._last = EffortCommand(k, tuple(tau), self._token)
         self._pub.publish(self._last)
         self.diagnostics.tick()
 

@@ -1,8 +1,10 @@
 """What the recorder did with each topic: received, written, missing stamps; its progress.
 
 Stamps are the samples' header stamps (or the effort command's ``effort@<stamp>`` label). A
-stamp more than 1.5 periods after the newest written so far counts the periods between as
-missing (gaps); the progress is the newest stamp written, minimum over the topics still flowing.
+stamp two periods or more after the newest written so far counts the whole periods between as
+missing (gaps): exact for lockstep stamps (``k * T``), a lower bound for a real-time device's
+system-clock stamps, which may each come up to a period after their grid point. The progress is
+the newest stamp written, minimum over the topics still flowing.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ class TopicCount:
     gaps: int = 0  # stamps missing between consecutive written messages (stamped topics)
     first_ns: int | None = None  # smallest stamp written
     newest_ns: int | None = None  # largest stamp written
+    durable_ns: int | None = None  # largest stamp written when the bag was last made durable
 
     def wrote(self, stamp_ns: int | None, period_ns: int) -> None:
         """Count a written message stamped ``stamp_ns`` (None: none); the loop period (ns)
@@ -39,8 +42,8 @@ class TopicCount:
         if newest is None:
             self.first_ns = self.newest_ns = stamp_ns
         elif stamp_ns > newest:
-            if stamp_ns - newest > period_ns + period_ns // 2:
-                self.gaps += round((stamp_ns - newest) / period_ns) - 1
+            if stamp_ns - newest >= 2 * period_ns:
+                self.gaps += (stamp_ns - newest) // period_ns - 1
             self.newest_ns = stamp_ns
         elif self.first_ns is not None and stamp_ns < self.first_ns:
             self.first_ns = stamp_ns

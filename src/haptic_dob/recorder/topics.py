@@ -1,18 +1,15 @@
-"""What the recorder records: its ``topics`` entries, each topic's subscription kind and stamps."""
+"""What the recorder records: its ``topics`` entries and each topic's subscription kind."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import Enum
 
-from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
-from haptic_msgs_py.topics import EFFORT_COMMAND, PARAMETER_EVENTS, SESSION_TOPICS
+from haptic_msgs_py.topics import PARAMETER_EVENTS, SESSION_TOPICS
 from haptic_msgs_py.wire import TYPESTORE
 
 PARAMETER_EVENT_TYPE = "rcl_interfaces/msg/ParameterEvent"
-
-StampReader = Callable[[bytes], int | None]
 
 
 class TopicKind(Enum):
@@ -67,13 +64,3 @@ def parse_topics(entries: Sequence[str]) -> list[TopicEntry]:
     if not out:
         raise ValueError("topics: nothing to record")
     return out
-
-
-def stamp_reader(topic: str, typename: str) -> StampReader | None:
-    """How to read the stamp (ns) of a message of this topic from its bytes (None: unstamped)."""
-    fields = TYPESTORE.fielddefs[typename][1]
-    if fields and fields[0][0] == "header":
-        return header_stamp_ns
-    if topic.rsplit("/", 1)[-1] == EFFORT_COMMAND:
-        return command_label_stamp_ns
-    return None

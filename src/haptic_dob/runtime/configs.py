@@ -1,8 +1,11 @@
-"""Find the configuration files the project installs under ``share/haptic_dob/config``."""
+"""Find the configuration files the project installs under ``share/haptic_dob/config``, and the
+files they name beside them."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 from haptic_dob.errors import InputError
 
@@ -33,3 +36,15 @@ def resolve_config(name_or_path: str | Path) -> Path:
         raise InputError(f"{p} is not a file")
     available = ", ".join(sorted(f.stem for f in config_dir().glob("*.yaml")))
     raise InputError(f"no config {str(name_or_path)!r}; a path or one of: {available}")
+
+
+def urdf_beside(sections: Mapping[str, dict[str, Any]], config: str | Path) -> None:
+    """Take a relative ``urdf_path`` of any section from the config's own directory where the
+    file is there, in place (the installed configs name ``urdf/arm7.urdf``,
+    ``urdf/phantom_omni.urdf`` beside them); else it stays relative to the working directory."""
+    here = Path(config).resolve().parent
+    for values in sections.values():
+        given = values.get("urdf_path")
+        relative = isinstance(given, str) and given and not Path(given).is_absolute()
+        if relative and (here / str(given)).is_file():
+            values["urdf_path"] = str(here / str(given))

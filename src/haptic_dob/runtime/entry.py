@@ -1,11 +1,12 @@
-"""Console entry points that a Ctrl-C during start-up ends quietly.
+"""Console entry points that a Ctrl-C or SIGTERM ends quietly, at any moment of start-up.
 
-``ros2 launch`` and a terminal send SIGINT to a node that may still be importing numpy,
-pinocchio and rclpy; Python would print a ``KeyboardInterrupt`` traceback. ``run_main`` installs
-a SIGINT handler that leaves at once with status 130 (128 + SIGINT) *before* importing the node's
-module (``os._exit``: an exception raised in the middle of an extension's import would surface as
-a chained ``ImportError``); the node's runtime (``haptic_dob.runtime.ros.spin.run_nodes``)
-replaces it with its clean shutdown once the node is up. The ``ros2 run`` shims (``ros/lib``)
+``ros2 launch`` and a terminal send SIGINT (then SIGTERM) to a node that may still be importing
+numpy, pinocchio and rclpy, or building its nodes, and count anything but exit 0 as a death.
+``run_main`` installs a handler for both that leaves at once with status 0 *before* importing the
+node's module (``os._exit``: the node does not exist yet, nothing is to be cleaned up, and an
+exception raised in the middle of an extension's import would surface as a chained
+``ImportError``); the node's runtime (``haptic_dob.runtime.ros.spin.run_nodes``) replaces it
+with its clean shutdown (exit 0) once rclpy is initialised. The ``ros2 run`` shims (``ros/lib``)
 keep SIGINT ignored from the shell to here, over the interpreter's own start-up. ROS-free and
 light: it imports the module only by name.
 """
@@ -17,13 +18,18 @@ import os
 import signal
 from types import FrameType
 
+#: the signals that end a node quietly (exit 0) however early they come
+QUIET_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
-def _leave(signum: int, _frame: FrameType | None) -> None:
-    os._exit(128 + signum)  # nothing to clean up yet: the node does not exist
+
+def _leave(_signum: int, _frame: FrameType | None) -> None:
+    os._exit(0)  # nothing to clean up yet: the node does not exist; a stop asked for is clean
 
 
 def run_main(module: str) -> int:
-    """Import ``module`` with Ctrl-C ending the process quietly, then return its ``main()``."""
-    signal.signal(signal.SIGINT, _leave)
+    """Import ``module`` with Ctrl-C/SIGTERM ending the process quietly, then return its
+    ``main()``."""
+    for signum in QUIET_SIGNALS:
+        signal.signal(signum, _leave)
     main = importlib.import_module(module).main
     return int(main() or 0)

@@ -3,7 +3,8 @@ in samples, and the watchdog that tells a silent peer.
 
 The receiver decides every message's fate as it is handed over (``push``, in the order of the
 messages' stamps): lost, or due at sample ``j + delay + u`` with ``u`` drawn from
-``[0, jitter]`` (``j`` the message's own sample). ``take(k)`` then gives the newest message due by
+``[0, jitter]`` (``j`` the message's own sample, counted from the sender's first:
+``SampleClock``). ``take(k)`` then gives the newest message due by
 sample ``k``. The draws come from the receiver's own seeded generator, one pair per message, so a
 batch run and a node graph that hand over the same messages see the same channel, bit for bit.
 In lockstep a receiver must have been handed every message that can be due by ``k`` (those of
@@ -30,6 +31,22 @@ def _quiet(*_args: str) -> None:
     """Report nowhere."""
 
 
+class SampleClock:
+    """One device's sample indices from its stamps: the whole periods since its first stamp
+    (the nearest: a real-time device stamps each sample with the system clock when it takes
+    it, a period apart give or take its wake-up jitter; lockstep stamps are ``k * T``)."""
+
+    def __init__(self, period_ns: int) -> None:
+        self.period_ns = period_ns
+        self.origin_ns: int | None = None  # the first stamp: sample 0
+
+    def index(self, stamp_ns: int) -> int:
+        """The sample index of stamp ``stamp_ns`` (ns)."""
+        if self.origin_ns is None:
+            self.origin_ns = stamp_ns
+        return (stamp_ns - self.origin_ns + self.period_ns // 2) // self.period_ns
+
+
 class DelayLine(Generic[M]):
     """The receiving end of one direction of the channel (messages of type ``M``).
 
@@ -49,6 +66,7 @@ class DelayLine(Generic[M]):
         back: Callable[[], None] = _quiet,
     ) -> None:
         self.period_ns = period_ns
+        self.sender = SampleClock(period_ns)  # the sender's sample indices
         self.delay = settings.delay_samples(period_ns)
         self.jitter = settings.jitter_samples(period_ns)
         self.loss = settings.loss
@@ -66,7 +84,7 @@ class DelayLine(Generic[M]):
 
     def push(self, stamp_ns: int, message: M) -> None:
         """Hand over the message of sample ``stamp_ns`` (stamps in increasing order)."""
-        j = stamp_ns // self.period_ns
+        j = self.sender.index(stamp_ns)
         if j <= self.pushed_j:
             return  # a repeated sample (lockstep re-send): decided already
         self.pushed_j = j

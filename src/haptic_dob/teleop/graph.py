@@ -22,6 +22,8 @@ SIDE_NODES = {
     "master": ("observer_node", "controller_node", "channel_node", "device_node"),
     "slave": ("observer_node", "slave_controller_node", "channel_node", "device_node"),
 }
+#: what may stand in a side's device's place: a bridge to a real driver (``bridge_node``)
+BRIDGE = "bridge_node"
 #: the channel's link between the ends (absolute: it joins the two namespaces)
 TO_SLAVE = "/teleop/to_slave"
 TO_MASTER = "/teleop/to_master"
@@ -65,14 +67,11 @@ def node_values(sections: Mapping[str, Mapping[str, Any]], ns: str, node: str) -
 def load_teleop_sections(path: str | Path) -> dict[str, dict[str, Any]]:
     """The YAML's sections, a relative ``urdf_path`` taken from the YAML's own directory (the
     installed ``teleop_sim.yaml`` names ``urdf/arm7.urdf`` beside it)."""
+    from haptic_dob.runtime.configs import urdf_beside
     from haptic_dob.runtime.params import load_sections
 
     sections = load_sections(path)
-    here = Path(path).resolve().parent
-    for values in sections.values():
-        given = values.get("urdf_path")
-        if isinstance(given, str) and given and not Path(given).is_absolute():
-            values["urdf_path"] = str(here / given)
+    urdf_beside(sections, path)
     return sections
 
 
@@ -82,11 +81,18 @@ def is_teleop(sections: Mapping[str, Any]) -> bool:
     return any(k.startswith(("/master/", "/slave/")) for k in sections)
 
 
+def device_of(sections: Mapping[str, Any], ns: str) -> str:
+    """The node in side ``ns``'s device's place: ``bridge_node`` when the YAML has a
+    ``/<ns>/bridge_node`` section (the side is a real driver, in real time), else
+    ``device_node``."""
+    return BRIDGE if f"/{ns}/{BRIDGE}" in sections else "device_node"
+
+
 def check_sections(sections: Mapping[str, Any]) -> None:
     """``ValueError`` for a section that names no node of a teleoperation graph."""
     known = {"/**", *(f"/{ns}/**" for ns in NAMESPACES)}
-    known |= {f"/**/{n}" for nodes in SIDE_NODES.values() for n in nodes}
-    known |= {f"/{ns}/{n}" for ns, nodes in SIDE_NODES.items() for n in nodes}
+    known |= {f"/**/{n}" for nodes in SIDE_NODES.values() for n in (*nodes, BRIDGE)}
+    known |= {f"/{ns}/{n}" for ns, nodes in SIDE_NODES.items() for n in (*nodes, BRIDGE)}
     unknown = sorted(set(sections) - known)
     if unknown:
         sides = ", ".join(f"/{ns}/{{{','.join(SIDE_NODES[ns])}}}" for ns in NAMESPACES)
@@ -95,7 +101,8 @@ def check_sections(sections: Mapping[str, Any]) -> None:
         )
 
 
-def graph_nodes() -> list[tuple[str, str]]:
-    """(namespace, node) of every node, in start order: each side's, the devices last."""
+def graph_nodes(sections: Mapping[str, Any] | None = None) -> list[tuple[str, str]]:
+    """(namespace, node) of every node, in start order: each side's, the devices last (a side's
+    ``bridge_node`` in its device's place, ``device_of``)."""
     first = [(ns, n) for ns in NAMESPACES for n in SIDE_NODES[ns] if n != "device_node"]
-    return [*first, *((ns, "device_node") for ns in NAMESPACES)]
+    return [*first, *((ns, device_of(sections or {}, ns)) for ns in NAMESPACES)]

@@ -4,20 +4,14 @@ Per cycle, with the joint state of sample k and the point ``x_d`` to track (m, b
 
 1. one damped-least-squares step of differential inverse kinematics moves the joint target
    ``q_d`` toward ``x_d``: ``dq = J# (x_d - p(q_d)) + (I - J# J) k_n (q_0 - q_d)``,
-   ``J# = J^T (J J^T + lambda^2 I)^-1`` at ``q_d``, the second term pulling the redundant joints
-   toward the start posture ``q_0`` in the null space; ``dq`` is limited to
-   ``max_joint_speed_rad_s`` per period;
-2. ``tau = K (q_d - q) - B q' + G(q)`` (gravity of the controller's model), saturated per joint
-   at the model's effort limits (``haptic_dob.core.control.saturate``).
+   ``J# = J^T (J J^T + lambda^2 I)^-1`` at ``q_d`` (the null-space term pulls toward the start
+   posture ``q_0``), ``dq`` limited to ``max_joint_speed_rad_s`` per period;
+2. ``tau = K (q_d - q) - B q' + G(q)`` (the controller's model's gravity), saturated per joint at
+   the model's effort limits (``haptic_dob.core.control.saturate``).
 
-The gains are matrices shaped by the inertia at the start pose: ``K = D(q_0) w^2``,
-``B = 2 zeta w D(q_0)`` with ``w = 2 pi bandwidth_hz``, so every mode of the arm (not only
-every joint) is a second-order loop of that bandwidth: diagonal gains ``D_ii w^2`` leave modes of
-joints with parallel axes turning against each other (little inertia, the sum of their gains)
-far above the bandwidth, where the 1 kHz loop chatters at 500 Hz. Per-joint gains, when given,
-are diagonal.
-``q_d`` and ``q_0`` start at the first sample's joint positions. In contact the target runs into
-the wall while the arm stops at it; the joints' springs push with the difference.
+Gains: ``K = D(q_0) w^2``, ``B = 2 zeta w D(q_0)``, ``w = 2 pi bandwidth_hz`` (per-joint gains,
+when given, are diagonal). ``q_d`` and ``q_0`` start at the first sample's joint positions.
+Why full matrices, and the target in contact: docs/design/teleoperation.md.
 """
 
 from __future__ import annotations

@@ -1,17 +1,15 @@
 """Publishers and subscriptions of the loop's topics: in process first, DDS for everyone else.
 
 ``LoopPublisher.publish(value)`` hands the value to the subscribers in this process at once
-(``haptic_msgs_py.bus``) and sends it on DDS after the command. In a process that hosts several
-nodes (composed), a topic goes on DDS only while a reader elsewhere is matched: the count follows
-the publisher's matched events, and a lockstep device waits for every publisher of its process to
-have matched the readers the graph shows before sample 0 (a reader that matches while the loop
-runs gets the samples from when this process has seen the match, a few milliseconds later). A
-node alone in its process sends always, as any ROS 2 publisher does, except ``on_demand`` topics
-(evaluation only), sent while a reader is matched. ``LoopSubscription`` takes values from
-publishers in this process and opens a DDS subscription only while the topic has none here, so a
-composed node never also receives its neighbour's message over DDS. Every node keeps its
+(``haptic_msgs_py.bus``) and sends it on DDS after the command. In a composed process a topic
+goes on DDS only while a reader elsewhere is matched (the count follows the publisher's matched
+events; a lockstep device waits before sample 0 until every publisher of its process matched the
+readers the graph shows); a node alone in its process sends always, but ``on_demand`` topics
+(evaluation only) only while a reader is matched. ``LoopSubscription`` takes values from
+publishers in this process and opens a DDS subscription only while the topic has none here
+(``listen_outside``: values from DDS too, to a callback of their own). Every node keeps its
 ordinary rclpy publishers, so ``ros2 topic list``/``info``/``echo`` see the same graph whether
-nodes share a process or not.
+nodes share a process or not. Why: docs/design/timing.md.
 """
 
 from __future__ import annotations
@@ -98,7 +96,8 @@ class LoopPublisher:
 
 
 class LoopSubscription:
-    """One loop topic's input: ``callback(value)`` from publishers here, or from DDS."""
+    """One loop topic's input: ``callback(value)`` from publishers here, or from DDS
+    (``outside(value)`` when given)."""
 
     def __init__(
         self,
@@ -107,28 +106,41 @@ class LoopSubscription:
         codec: Codec,
         callback: Callable[[Any], None],
         qos: QoSProfile,
+        outside: Callable[[Any], None] | None = None,
     ) -> None:
         self.node = node
         self.topic = node.resolve_topic_name(topic)
         self._name = topic
-        self._callback = callback
+        self._callback = outside or callback
         self._decode = codec.decoder()
         self._type = rclpy_type(codec.typename)
         self._qos = qos
         self.dds: Any = None
+        self.outside = False  # listen on DDS while a publisher is here, too
         self.bus = bus_for(node.context)
         self.bus.join(node.get_fully_qualified_name())
         self._topic = self.bus.add_subscriber(self.topic, callback, self._follow)
         self._follow()
 
+    @property
+    def local(self) -> int:
+        """Publishers of the topic in this process."""
+        return len(self._topic.publishers)
+
+    def listen_outside(self, on: bool) -> None:
+        """Listen on DDS also while a publisher of the topic is in this process (``on``), or
+        only while none is (the default)."""
+        self.outside = on
+        self._follow()
+
     def _follow(self) -> None:
-        """Listen on DDS exactly while no publisher of the topic is in this process."""
-        local = bool(self._topic.publishers)
-        if not local and self.dds is None:
+        """Listen on DDS while no publisher of the topic is in this process (or ``outside``)."""
+        listen = self.outside or not self._topic.publishers
+        if listen and self.dds is None:
             self.dds = self.node.create_subscription(
                 self._type, self._name, self._on_bytes, self._qos, raw=True
             )
-        elif local and self.dds is not None:
+        elif not listen and self.dds is not None:
             self.node.destroy_subscription(self.dds)
             self.dds = None
 

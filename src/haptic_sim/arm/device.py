@@ -21,13 +21,14 @@ effort that gives ``max_force_n`` at the tip there (``haptic_sim.arm.params`` gi
 Encoders: joint angles quantized to ``encoder_resolution_rad`` (0 = ideal); velocity is the
 backward difference of the encoder readings, as a driver computes it.
 
-Hand (3-D, ``haptic_sim.hand``): a mass ``m_h`` moving with the handle, held by a grip spring and
-damper to a reference ``x_r(t) = p0 + u r(t) + e1 r1(t) + e2 r2(t)``: ``p0`` the start position of
-the end effector, ``u`` the push direction (``hand_direction``), ``r(t)`` the 1-D reference of
-``hand.py`` (push-and-hold or semi-random, with its ramp and force pulse along ``u``) and ``r1``,
-``r2`` semi-random motions across ``u`` (``hand_lateral_amplitude_m``, default 0). Force on the
-device ``F_h = k_h (x_r - p) + b_h (x_r' - p') + f_ff u - m_h p''``; the hand mass enters the
-dynamics exactly (``D + m_h J^T J``, bias ``+ m_h J^T J' q'``). ``behaviour: none``: no hand.
+Hand (3-D, ``haptic_sim.hand_space``): a mass ``m_h`` moving with the handle, held by a grip
+spring and damper to a reference ``x_r(t) = p0 + u r(t) + e1 r1(t) + e2 r2(t)``: ``p0`` the start
+position of the end effector, ``u`` the push direction (``hand_direction``), ``r(t)`` the 1-D
+reference of ``hand.py`` (push-and-hold or semi-random, with its ramp and force pulse along
+``u``) and ``r1``, ``r2`` semi-random motions across ``u`` (``hand_lateral_amplitude_m``, default
+0). Force on the device ``F_h = k_h (x_r - p) + b_h (x_r' - p') + f_ff u - m_h p''``; the hand
+mass enters the dynamics exactly (``D + m_h J^T J``, bias ``+ m_h J^T J' q'``). ``behaviour:
+none``: no hand.
 
 Contact (``contact``, ``haptic_sim.arm.contact``): a wall the end effector touches, its force
 evaluated at every integration stage from the stage's tip point and velocity and added to the
@@ -41,7 +42,6 @@ reading the total external force on the end effector (hand, external force and c
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Any, cast
 
 import numpy as np
@@ -55,18 +55,11 @@ from haptic_sim.arm.dynamics import coulomb_smoothing, dynamics_and_tip, mass_an
 from haptic_sim.arm.params import ArmDeviceParams
 from haptic_sim.device.sample import DeviceSample
 from haptic_sim.hand import HandParams, HandReference
+from haptic_sim.hand_space import hand_references
 from haptic_sim.sensor import ForceSensor, ForceSensorParams
 
 _ZERO3 = np.zeros(3)
 _NO_J = np.zeros((3, 0))  # the Jacobian slot of ``_last`` on the ABA path (unused there)
-
-
-def _perpendiculars(u: Vec) -> tuple[Vec, Vec]:
-    """Two unit vectors completing ``u`` to a right-handed orthonormal basis."""
-    a = np.array([1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    e1 = np.cross(u, a)
-    e1 /= np.linalg.norm(e1)
-    return e1, np.cross(u, e1)
 
 
 class SimulatedArm:
@@ -131,7 +124,6 @@ class SimulatedArm:
         self._neg_lim = -self.effort_limits
         # hand and external force
         self._u = unit_vector("hand_direction", dev.hand_direction)
-        self._e1, self._e2 = _perpendiculars(self._u)
         self._f_ext = vector("external_force_n", dev.external_force_n, 3)
         self._ext_on_step = (
             math.ceil(dev.external_force_at_s / self.dt_physics - 1e-9)
@@ -141,19 +133,9 @@ class SimulatedArm:
         seeds = np.random.SeedSequence(seed).spawn(6)
         rngs = [np.random.default_rng(s) for s in seeds]
         h = self.hand
-        self._ref: list[tuple[HandReference, Vec]] = []
-        if h.active:
-            self._ref.append((HandReference(h, self.dt_physics, rngs[0]), self._u))
-            if dev.hand_lateral_amplitude_m > 0.0:
-                lateral = replace(
-                    h,
-                    behaviour="semi_random",
-                    offset_m=0.0,
-                    amplitude_m=dev.hand_lateral_amplitude_m,
-                    perturbation_n=0.0,
-                )
-                for rng, e in ((rngs[1], self._e1), (rngs[2], self._e2)):
-                    self._ref.append((HandReference(lateral, self.dt_physics, rng), e))
+        self._ref: list[tuple[HandReference, Vec]] = hand_references(
+            h, self._u, dev.hand_lateral_amplitude_m, self.dt_physics, rngs
+        )
         self._sensors = [ForceSensor(self.sensor_params, self.dt_physics, r) for r in rngs[3:]]
         self.contact = contact_of(contact)
         self._contact = None if self.contact is None else self.contact.force

@@ -30,6 +30,7 @@ from haptic_dob.core.models.factory import build_model
 from haptic_dob.core.models.phantom import PhantomModel
 from haptic_dob.core.observers.factory import ObserverSettings
 from haptic_dob.core.tip_force import dls_transpose_solve
+from haptic_dob.runtime.configs import urdf_beside
 from haptic_dob.runtime.params import build, load_node_params, node_view, replace_groups
 from haptic_sim.arm.device import ArmDeviceParams, SimulatedArm
 from haptic_sim.hand import HandParams
@@ -87,8 +88,11 @@ class ArmSessionConfig:
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> ArmSessionConfig:
-        """Load a ``ros__parameters`` YAML file (the one the node graph is launched with)."""
-        return cls.from_node_params(load_node_params(path))
+        """Load a ``ros__parameters`` YAML file (the one the node graph is launched with; a
+        relative ``urdf_path`` beside it, as the launcher takes it)."""
+        nodes = load_node_params(path)
+        urdf_beside(nodes, path)
+        return cls.from_node_params(nodes)
 
 
 @dataclass(frozen=True)

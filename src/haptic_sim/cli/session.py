@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from haptic_dob.cli.common import ArgumentParser, run
@@ -14,6 +15,7 @@ from haptic_dob.core.validation import nonnegative, positive
 from haptic_dob.runtime.configs import resolve_config
 from haptic_dob.runtime.params import load_node_params, node_view
 from haptic_sim.arm.session import ArmSessionConfig, ArmSessionSummary, run_arm_session
+from haptic_sim.device.batch import BatchSummary, load_session, run_batch, summarize
 from haptic_sim.slide.session import SessionConfig, SessionSummary, run_session
 from haptic_sim.slide.stability import law_for
 
@@ -31,6 +33,10 @@ def command(
     """Load, override, run, print; raises ``ValueError``/``InputError`` on bad input."""
     path = resolve_config(config)
     model = node_view(load_node_params(path), "device_node").get("model", "slide")
+    if model == "point_mass":
+        overrides = Overrides(controller, kf, stiffness, duration, seed)
+        print_summary(run_cartesian(path, overrides, save), save, as_json)
+        return 0
     if model != "slide":
         print_summary(run_arm(path, controller, kf, stiffness, duration, seed, save), save, as_json)
         return 0
@@ -88,8 +94,43 @@ def run_arm(
     return result.summary()
 
 
+@dataclass(frozen=True)
+class Overrides:
+    """What the command line changes in a config (None: the config's)."""
+
+    controller: str | None
+    kf: float | None
+    stiffness: float | None
+    duration: float | None
+    seed: int | None
+
+
+def run_cartesian(path: Path, o: Overrides, save: str | None) -> BatchSummary:
+    """A Cartesian point-mass device's session (``haptic_sim.device.batch``), the overrides set
+    as the nodes' parameters (``--stiffness`` leaves the hand's push as the config has it):
+    headline figures of the estimate in contact."""
+    nodes = load_session(path)
+    ctl, env, dev = (
+        nodes.setdefault(n, {}) for n in ("controller_node", "environment_node", "device_node")
+    )
+    if o.controller is not None:
+        ctl["mode"] = o.controller
+    if o.kf is not None:
+        ctl["kf"] = nonnegative("--kf", o.kf)
+    if o.stiffness is not None:
+        env["stiffness_n_per_m"] = positive("--stiffness", o.stiffness)
+    if o.duration is not None:
+        dev["duration_s"] = positive("--duration", o.duration)
+    if o.seed is not None:
+        dev["seed"] = int(nonnegative("--seed", o.seed))
+    record = run_batch(nodes)
+    if save:
+        record.save(save)
+    return summarize(record, nodes)
+
+
 def print_summary(
-    figures: SessionSummary | ArmSessionSummary, saved: str | None, as_json: bool
+    figures: SessionSummary | ArmSessionSummary | BatchSummary, saved: str | None, as_json: bool
 ) -> None:
     """JSON, or one aligned ``key  value`` line per figure (and where the arrays went)."""
     summary: dict[str, object] = dict(dataclasses.asdict(figures))

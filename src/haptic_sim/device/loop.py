@@ -1,20 +1,22 @@
 """The simulated device's cycle, ROS-free: when sample k goes out and which command moves the plant.
 
 - lockstep: sample 0 goes out once the graph is up (``LoopPort.waiting_for``) and settled; sample
-  k+1 only after command k arrived (labelled with sample k's stamp, or unlabelled). Without a
-  command for ``lockstep_timeout_s`` the loop says so and sends sample k again. While a recorder
-  lags (``RecorderGate``) command k is held; after the last sample the run ends once the recorder
-  has written it.
-- realtime: ticks every period once the graph is up and applies the newest valid command; the
-  watchdog (``CommandWatchdog``) zeroes the effort when commands stop; ``RealtimeStats`` counts
-  whether command k came before the next tick.
+  k+1 only after command k came (labelled with sample k's stamp, or unlabelled); without it for
+  ``lockstep_timeout_s`` the loop says so and sends sample k again. While a recorder lags
+  (``RecorderGate``) command k is held; the run ends once the recorder wrote the last sample.
+- realtime: ticks on the wall clock's grid (sample 0's time plus whole periods) once the graph is
+  up, applies the newest valid command, steps the plant one period and stamps the sample with the
+  system clock. A tick a period or more late is an overrun and the grid points it passed are
+  missed ticks, lost (docs/running.md, "Clock modes"): a run of ``last_k`` periods ends
+  ``last_k`` periods after sample 0. ``CommandWatchdog`` counts the samples sent and zeroes the
+  effort when commands stop; ``RealtimeStats`` counts commands before the next tick, and overruns.
 
-Every command passes the ``CommandGuard`` first. The node behind ``LoopPort`` publishes, runs
-deferred work and answers questions about the ROS graph; the loop tells it what to do.
+Every command passes the ``CommandGuard`` first; ``LoopPort``, the node, does what the loop says.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Mapping
 from typing import Any, Protocol
@@ -23,12 +25,11 @@ from haptic_dob.core.command_guard import CommandGuard
 from haptic_dob.core.watchdog import CommandWatchdog
 from haptic_msgs_py.topics import EFFORT_COMMAND
 from haptic_msgs_py.values import EffortCommand
-from haptic_sim.arm.device import SimulatedArm
 from haptic_sim.device.cycle_stats import CycleStats, RealtimeStats
+from haptic_sim.device.factory import SimulatedDeviceKind
 from haptic_sim.device.recorder_gate import Drain, RecorderGate
 from haptic_sim.device.sample import DeviceSample
 from haptic_sim.device.settings import DeviceLoopSettings
-from haptic_sim.slide.device import SimulatedSlide
 
 STARTUP_RESEND_S = 0.5  # lockstep: sample 0 again this often until command 0 comes
 GRAPH_POLL_S = 0.05  # how often the start and the end of a run look at the graph again
@@ -74,19 +75,23 @@ class DeviceLoop:
         log: where the loop says what it does.
         values: the node's parameter values (``settings_for``; ``ValueError`` when refused).
         lockstep: lockstep (True) or real time.
-        last_k: the run ends after publishing this sample (None: never).
+        last_k: the run ends after publishing this sample (in real time: the sample of this grid
+            point; None: never).
+        clock_ns: the system clock that stamps a real-time sample (ns).
     """
 
     def __init__(
         self,
-        device: SimulatedSlide | SimulatedArm,
+        device: SimulatedDeviceKind,
         port: LoopPort,
         log: Log,
         values: Mapping[str, Any],
         lockstep: bool,
         last_k: int | None,
+        clock_ns: Callable[[], int] = time.time_ns,
     ) -> None:
         self.device = device
+        self.clock_ns = clock_ns
         self.port = port
         self.log = log
         self.lockstep = lockstep
@@ -105,6 +110,9 @@ class DeviceLoop:
         self.stepped = False  # lockstep: command k applied, sample k+1 not yet published
         self.ready_since: float | None = None  # monotonic s the graph was first up
         self.t_first = 0.0  # monotonic s of sample 0
+        self.grid = 0  # real time: the wall-clock period of the newest tick since sample 0
+        self.ticks = 0  # real time: samples sent after sample 0 (the watchdog's count)
+        self.stamp_ns = 0  # the stamp of the newest sample sent
         self.deadline = time.monotonic() + 0.1  # monotonic s of the next wake-up
         self.sent_s = 0.0  # monotonic s the newest sample went out
 
@@ -131,7 +139,7 @@ class DeviceLoop:
         self._news = (
             True,
             f"watchdog: no valid {EFFORT_COMMAND} for {held} (limit {timeout * 1e3:g} ms of "
-            f"simulated time): effort zeroed ({self.watchdog.trips} trips so far)",
+            f"samples sent): effort zeroed ({self.watchdog.trips} trips so far)",
         )
 
     def _say_resumed(self) -> None:
@@ -178,8 +186,8 @@ class DeviceLoop:
             return
         now = time.monotonic()
         self.latest = effort
-        self.watchdog.fed(k)
-        if stamp == current and self.realtime.command(k, now - self.sent_s):
+        self.watchdog.fed(self.ticks)
+        if stamp == self.stamp_ns and self.realtime.command(k, now - self.sent_s):
             self.port.call_soon(self.device.prepare)  # the loop is idle until the next tick
 
     def progress(self, recorder: str, written_ns: int) -> None:
@@ -206,7 +214,11 @@ class DeviceLoop:
             self.port.call_soon(self.send_sample)
 
     def publish(self, sample: DeviceSample) -> None:
-        """Sample k to every topic (its send time starts the command's latency)."""
+        """Sample k to every topic (its send time starts the command's latency); in real time
+        stamped with the system clock as it is taken."""
+        if not self.lockstep:
+            sample = dataclasses.replace(sample, stamp_ns=self.clock_ns())
+        self.stamp_ns = sample.stamp_ns
         self.sent_s = time.monotonic()
         self.port.publish(sample)
 
@@ -214,7 +226,8 @@ class DeviceLoop:
         """Publish the current sample; in lockstep arm the re-send and end the run at its end."""
         self.stepped = False
         s = self.device.sample()
-        last = self.last_k is not None and s.k >= self.last_k and not self.recorders.draining
+        at = s.k if self.lockstep else self.grid  # real time: the run lasts its periods
+        last = self.last_k is not None and at >= self.last_k and not self.recorders.draining
         if last:  # the run ends with this sample: a command that answers it moves nothing
             self.recorders.start_drain(time.monotonic())
         self.publish(s)
@@ -225,9 +238,15 @@ class DeviceLoop:
         if last:
             wall = time.monotonic() - self.t_first
             sim = s.k * self.period_ns * 1e-9
+            rt = self.realtime
+            missed = (
+                ""
+                if self.lockstep
+                else f"; {rt.missed_ticks} ticks missed in {rt.overruns} overruns"
+            )
             self.log.info(
                 f"finished: {s.k} cycles ({sim:g} s simulated) in {wall:.2f} s, "
-                f"real-time factor {sim / wall:.2f}"
+                f"real-time factor {sim / wall:.2f}{missed}"
             )
             # stay up (publishers alive) until a recorder has written the last sample
             self.deadline = time.monotonic()
@@ -235,8 +254,7 @@ class DeviceLoop:
 
     def check_drained(self) -> None:
         """Finish once no recorder reports, or it has written the last sample (or time is up)."""
-        last_ns = self.device.k * self.period_ns
-        drain = self.recorders.drain(last_ns, self.port.recorders(), time.monotonic())
+        drain = self.recorders.drain(self.stamp_ns, self.port.recorders(), time.monotonic())
         if drain is Drain.TIMED_OUT:
             self.log.warning(
                 "the recorder has not written the last sample after "
@@ -324,7 +342,7 @@ class DeviceLoop:
 
     def tick(self, now: float) -> None:
         """Real time: apply the newest valid command (zero when the watchdog trips), send the
-        next sample, schedule the next tick (sample 0 on the first)."""
+        next sample, schedule the next tick on the grid (sample 0 on the first)."""
         period = self.period_ns * 1e-9
         if not self.started:
             self.started = True
@@ -333,14 +351,17 @@ class DeviceLoop:
             self.deadline = now + period
             return
         k = self.device.k
+        grid = self.realtime.tick_at(self.grid, now - self.t_first, period)  # counts overruns
         self.realtime.tick(k)  # late when command k did not come (once the loop has closed)
         effort = self.latest
-        if self.watchdog.due(k, self.settings.command_timeout_s):
+        if self.watchdog.due(self.ticks, self.settings.command_timeout_s):
             effort = self.zero
         self.advance(effort)
+        self.grid = grid
+        self.ticks += 1
         self.send_sample()
         self._say_pending(now)
-        self.deadline = self.realtime.next_deadline(self.deadline, now, period)
+        self.deadline = self.t_first + (grid + 1) * period
 
     # --- end ------------------------------------------------------------------------------
     def stats(self) -> CycleStats:

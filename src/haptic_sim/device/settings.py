@@ -1,10 +1,11 @@
 """The device node's parameters: the rows it declares and the settings its loop reads of them.
 
 ``device_node_specs`` is the whole table (``docs/parameters.md`` lists it in this order):
-``safety_specs`` (the watchdog's timeout, the command guard's limits), the loop, process, model,
-clock and simulation rows, then ``schedule_specs`` (lockstep re-sends, the start-up gate,
-recorder back-pressure, the statistics file). ``DeviceLoopSettings`` is what the loop reads of
-them at run time; ``missing_nodes`` which of ``wait_for`` the graph lacks.
+``safety_specs`` (the watchdog's timeout, the command guard's limits), the loop, input, command
+authority (who may command the device), process, model, clock and simulation rows, then
+``schedule_specs`` (lockstep re-sends, the start-up gate, recorder back-pressure, the statistics
+file). ``DeviceLoopSettings`` is what the loop reads of them at run time (``missing_nodes``,
+which of ``wait_for`` the graph lacks, is the nodes' common helper).
 """
 
 from __future__ import annotations
@@ -14,15 +15,31 @@ from dataclasses import dataclass
 from typing import Any
 
 from haptic_dob.core.models.factory import model_specs
-from haptic_dob.nodes.common import CLOCK_MODES, input_specs, loop_specs, process_specs
+from haptic_dob.nodes.common import (
+    CLOCK_MODES,
+    command_authority_specs,
+    input_specs,
+    loop_specs,
+    process_specs,
+)
 from haptic_dob.runtime.params import ParamSpec
 from haptic_sim.device.factory import simulation_specs
 
 DEFAULT_WAIT_FOR = ["environment_node", "observer_node", "controller_node"]
 
 
-#: model parameters a simulated device does not take (its own physics are ``plant.*``)
-ASSUMED_ONLY = frozenset({"slide.mass_kg", "slide.viscous_n_s_per_m", "slide.coulomb_n"})
+#: model parameters a simulated device does not take (its own physics are ``plant.*`` or
+#: ``cartesian.*``)
+ASSUMED_ONLY = frozenset(
+    {
+        "slide.mass_kg",
+        "slide.viscous_n_s_per_m",
+        "slide.coulomb_n",
+        "point_mass.mass_kg",
+        "point_mass.viscous_n_s_per_m",
+        "point_mass.coulomb_n",
+    }
+)
 
 
 def device_node_specs() -> list[ParamSpec]:
@@ -31,13 +48,16 @@ def device_node_specs() -> list[ParamSpec]:
         *safety_specs(),
         *loop_specs(),
         *input_specs("reliable"),
+        *command_authority_specs(),
         *process_specs(),
-        # the slide's physics is plant.* (its truth); slide.* is the model the others assume
+        # the slide's physics is plant.* (its truth), the point mass's cartesian.*; slide.* and
+        # point_mass.* are the model the others assume
         *(s for s in model_specs() if s.name not in ASSUMED_ONLY),
         ParamSpec(
             "clock_mode",
             "lockstep",
-            "lockstep: advance when command k arrived; realtime: tick at rate_hz",
+            "lockstep: advance when command k arrived (stamps k * T); realtime: tick at rate_hz on "
+            "the wall clock (stamps: the system clock when each sample is taken)",
             choices=CLOCK_MODES,
             read_only=True,
         ),
@@ -52,8 +72,8 @@ def safety_specs() -> list[ParamSpec]:
         ParamSpec(
             "command_timeout_s",
             0.005,
-            "realtime watchdog: zero effort when no valid command came for this long of "
-            "simulated time (samples: a stall of the device's own process does not count)",
+            "realtime watchdog: zero effort when no valid command came for this long, counted in "
+            "the samples the device sent (a stall of the device's own process does not count)",
             "s",
             0.0005,
             1.0,
@@ -158,17 +178,3 @@ def start_topics(start_with: Iterable[str]) -> list[str]:
             )
         out.append(f"{name.rpartition('/')[0]}/joint_states")
     return out
-
-
-def missing_nodes(
-    wait_for: Iterable[str], graph: Iterable[tuple[str, str]], namespace: str
-) -> list[str]:
-    """The ``wait_for`` entries that are not up in ``graph`` ((name, namespace) of each node): a
-    plain name is a node of ``namespace``, one starting with ``/`` a fully qualified name (a
-    recorder elsewhere, such as ``ros2 bag record``'s ``/rosbag2_recorder``)."""
-    here, everywhere = set(), set()
-    for name, space in graph:
-        everywhere.add(f"{space.rstrip('/')}/{name}")
-        if space == namespace:
-            here.add(name)
-    return [w for w in wait_for if w not in (everywhere if w.startswith("/") else here)]

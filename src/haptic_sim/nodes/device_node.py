@@ -1,6 +1,7 @@
 """device_node: a simulated haptic device on the lab network, in lockstep or in real time.
 
-Publishes per sample k (stamp ``k * T``): ``ee_pose``, ``ee_twist``, ``joint_states`` (position,
+Publishes per sample k (stamped ``k * T`` in lockstep, the system clock when taken in real time):
+``ee_pose``, ``ee_twist``, ``joint_states`` (position,
 velocity, and the effort applied over [k-1, k) after saturation), ``wrench_measured`` (the handle
 force sensor), ``sim/hand_wrench`` (the true hand force, for evaluation) and ``/clock`` (the
 stamp as ROS time, in both clock modes; these two only while someone reads them). Takes
@@ -14,15 +15,20 @@ stamp as ROS time, in both clock modes; these two only while someone reads them)
   time, so a recording of a lockstep run never loses a sample. Stops after ``duration_s``
   (0: never), once a recorder (if any) has written the last sample.
 - realtime: once the ``wait_for`` nodes are up (as in lockstep; ``[]`` starts at once), ticks at
-  ``rate_hz`` and applies the newest valid command; records whether command k arrived before the
-  next tick and its latency (``stats_file``).
+  ``rate_hz`` on the wall clock's grid and applies the newest valid command; a tick a period or
+  more late is an overrun and the grid points it passed are missed ticks (time never slows: a
+  ``duration_s`` run lasts ``duration_s``, with a sample fewer per missed tick);
+  records whether command k arrived before the next tick, its latency and the overruns
+  (``stats_file``).
 
 Safety (every path, both modes): each joint's effort is clamped to ``effort_limits`` (at most the
 actuator's own saturation; changeable at run time); a command of the wrong length or with NaN/inf
 is refused and counts as zero effort (counted, logged once per burst); in real time a watchdog
 zeroes the effort when no valid command came for ``command_timeout_s`` and says so, and the next
-valid command resumes; at shutdown the effort goes to zero first. ``/diagnostics`` reports the
-loop rate, deadline misses, the watchdog, refused and limited commands.
+valid command resumes; at shutdown the effort goes to zero first. Only the loop's own controller
+commands it (``haptic_dob.nodes.command_input``; ``open_command_input``, off as on a real device,
+opens it). ``/diagnostics`` reports the loop rate, overruns and missed ticks, the watchdog,
+refused, limited and foreign commands.
 """
 
 from __future__ import annotations
@@ -36,13 +42,14 @@ from typing import Any
 
 from rclpy.context import Context
 
-from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.command_input import CommandInput
+from haptic_dob.nodes.common import main_for, missing_nodes
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
-from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
+from haptic_msgs_py.ros.loop_io import LoopPublisher
 from haptic_msgs_py.ros.raw import raw_subscription
 from haptic_msgs_py.stamps import NS_PER_S
 from haptic_msgs_py.topics import (
@@ -63,7 +70,6 @@ from haptic_sim.device.sample import DeviceSample
 from haptic_sim.device.settings import (
     DeviceLoopSettings,
     device_node_specs,
-    missing_nodes,
     start_topics,
 )
 
@@ -101,11 +107,12 @@ class DeviceNode(LoopNode):
         self._p_measured = pub(WRENCH_MEASURED, codecs.WRENCH)
         # evaluation topics: sent only while someone listens
         self._p_hand = pub(HAND_WRENCH, codecs.WRENCH, on_demand=True)
-        # the sample's stamp as ROS time, in both clock modes: tools with use_sim_time (ros2 bag
-        # record --use-sim-time, a node's -p use_sim_time:=true) share the loop's time base
+        # the sample's stamp as ROS time, in both clock modes (in real time the system clock's):
+        # tools with use_sim_time (ros2 bag record --use-sim-time, a node's -p
+        # use_sim_time:=true) share the loop's time base
         self._p_clock = LoopPublisher(self, CLOCK, codecs.CLOCK, qos.CLOCK, on_demand=True)
         inputs = qos.loop_input(v["input_reliability"])
-        self._sub = LoopSubscription(self, EFFORT_COMMAND, codecs.EFFORT, self.loop.command, inputs)
+        self._sub = CommandInput(self, self.loop.command, inputs, v)
         self._bus = self._sub.bus
         # both modes: sample 0 waits for the recorders' readers to match; lockstep back-pressure
         raw_subscription(
@@ -214,16 +221,22 @@ class DeviceNode(LoopNode):
             "refused_commands": loop.guard.refused,
             "limited_commands": loop.guard.limited,
             "effort_limits": list(self.limits),
+            **self._sub.report(),
         }
         if not self.lockstep:
             rt = loop.realtime
             values.update(
-                deadline_misses=rt.missed_ticks, late_commands=rt.late, on_time_commands=rt.on_time
+                overruns=rt.overruns,
+                missed_ticks=rt.missed_ticks,
+                late_commands=rt.late,
+                on_time_commands=rt.on_time,
             )
         if tripped:
             return WARN, "watchdog tripped: no valid effort_command, effort zeroed", values
         if loop.guard.refusing:
             return WARN, "refusing invalid effort_command (zero effort)", values
+        if self._sub.refusing():
+            return WARN, "refused effort_command from publishers other than the loop's", values
         if not loop.started:
             return OK, "waiting for the graph", values
         return OK, "running", values

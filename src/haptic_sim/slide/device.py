@@ -21,8 +21,9 @@ each the exact solution of the linear part (mass, viscous friction, grip spring 
 reference and the friction held over the step. Exact integration matters: a semi-implicit Euler
 step moves the mass ahead of the held force by ``T / (2 n)`` and raises the open-loop onset by
 ``n / (n-1)``. The command is held over the period (zero-order hold) and saturated at
-``max_force_n``. The encoder quantizes to ``encoder_resolution_m``; velocity is the backward
-difference of the encoder positions, as a real device's driver computes it.
+``max_force_n``. The encoder quantizes to ``encoder_resolution_m`` (after a white noise of
+``encoder_noise_m``, 0 by default); velocity is the backward difference of the encoder positions,
+as a real device's driver computes it.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ from haptic_dob.core.validation import finite_scalar, nonnegative, positive, uni
 from haptic_dob.runtime.params import param
 from haptic_msgs_py.stamps import period_ns
 from haptic_sim.device.sample import DeviceSample
-from haptic_sim.hand import HandParams, HandReference
+from haptic_sim.hand import HandParams, HandReference, Reference
 from haptic_sim.sensor import ForceSensor, ForceSensorParams, quantize
 
 
@@ -90,6 +91,12 @@ class SlideDeviceParams:
         default=5e-5,
         metadata=param("time constant of the amplifier's current loop", "s", 0.0, 0.1),
     )
+    encoder_noise_m: float = field(
+        default=0.0,
+        metadata=param(
+            "white noise on the position before the encoder counts (std)", "m", 0.0, 1e-2
+        ),
+    )
 
     def __post_init__(self) -> None:
         positive("max_force_n", self.max_force_n)
@@ -102,6 +109,7 @@ class SlideDeviceParams:
             raise ValueError(f"stiction_ratio must be >= 1, got {self.stiction_ratio!r}")
         nonnegative("stribeck_velocity_m_per_s", self.stribeck_velocity_m_per_s)
         nonnegative("amplifier_lag_s", self.amplifier_lag_s)
+        nonnegative("encoder_noise_m", self.encoder_noise_m)
 
     @classmethod
     def matching(cls, model: SlideParams, **settings: float) -> SlideDeviceParams:
@@ -134,8 +142,10 @@ class SimulatedSlide:
         hand: hand settings.
         rate_hz: control rate (Hz), > 0.
         substeps: physics steps per control period, >= 1.
-        seed: seed of the hand's reference and the sensor noise.
+        seed: seed of the hand's reference, the sensor noise and the encoder noise.
         axis: the slide's direction in the base frame (unit 3-vector).
+        reference: the hand's reference along the axis, shared with other axes (None: one of its
+            own from ``hand``, whose grip, mass and behaviour it takes either way).
     """
 
     dof = 1
@@ -149,6 +159,7 @@ class SimulatedSlide:
         substeps: int = 10,
         seed: int = 0,
         axis: tuple[float, float, float] = (1.0, 0.0, 0.0),
+        reference: Reference | None = None,
     ) -> None:
         self.device = device or SlideDeviceParams()
         self.sensor_params = sensor or ForceSensorParams()
@@ -167,11 +178,14 @@ class SimulatedSlide:
         ).model()
         self.max_effort = (d.max_force_n,)  # actuator saturation per joint
         self._axis = tuple(float(a) for a in self.model.axis)
-        hand_rng, sensor_rng = (
-            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2)
+        hand_rng, sensor_rng, encoder_rng = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
         )
-        self._reference = HandReference(self.hand, self.dt_physics, hand_rng)
+        self._reference: Reference = (
+            HandReference(self.hand, self.dt_physics, hand_rng) if reference is None else reference
+        )
         self._sensor = ForceSensor(self.sensor_params, self.dt_physics, sensor_rng)
+        self._encoder_rng = encoder_rng
         self._discretise()
         # state
         self._k = 0
@@ -180,7 +194,7 @@ class SimulatedSlide:
         self.accel = 0.0
         self.applied_force = 0.0  # N: the amplifier's output (lags the command)
         self.hand_force_true = 0.0
-        self._q = quantize(self.x, d.encoder_resolution_m)
+        self._q = self._encode(self.x)
         self._q_prev = self._q
         self._effort_applied = 0.0
         self._i_phys = 0
@@ -216,8 +230,15 @@ class SimulatedSlide:
         self._effort_applied = u
         self._k += 1
         self._q_prev = self._q
-        self._q = quantize(self.x, self.device.encoder_resolution_m)
+        self._q = self._encode(self.x)
         self._sample = self._make_sample()
+
+    def _encode(self, x: float) -> float:
+        """The encoder's reading of position ``x`` (m): its noise, then its counts."""
+        d = self.device
+        if d.encoder_noise_m > 0.0:
+            x += d.encoder_noise_m * float(self._encoder_rng.standard_normal())
+        return quantize(x, d.encoder_resolution_m)
 
     # ------------------------------------------------------------------------------------------
     def _integrate(self, u: float) -> None:

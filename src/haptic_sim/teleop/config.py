@@ -19,8 +19,7 @@ from haptic_dob.teleop.graph import NAMESPACES, check_sections, load_teleop_sect
 from haptic_dob.teleop.settings import ChannelSettings, TeleopSettings
 from haptic_dob.teleop.slave import SlaveImpedance
 from haptic_sim.arm.device import SimulatedArm
-from haptic_sim.device.factory import NO_CONTACT, build_device
-from haptic_sim.slide.device import SimulatedSlide
+from haptic_sim.device.factory import NO_CONTACT, SimulatedDeviceKind, build_device
 from haptic_sim.slide.session import LoopSettings
 
 
@@ -57,7 +56,7 @@ class TeleopConfig:
             return node_values(secs, ns, node)
 
         m_dev, s_dev = of("master", "device_node"), of("slave", "device_node")
-        if s_dev.get("model", "slide") == "slide":
+        if s_dev.get("model", "slide") not in ("urdf", "phantom"):
             raise ValueError("the slave is an arm: /slave/device_node needs model urdf or phantom")
         ends = [
             (
@@ -108,8 +107,8 @@ class TeleopConfig:
             secs.setdefault(section, {}).update(values)
         return TeleopConfig.from_sections(secs)
 
-    def master_device(self) -> SimulatedSlide | SimulatedArm:
-        """The simulated master (slide or PHANToM, with its hand)."""
+    def master_device(self) -> SimulatedDeviceKind:
+        """The simulated master (slide, point mass or PHANToM, with its hand)."""
         return build_device(self.values("master", "device_node"))
 
     def slave_device(self) -> SimulatedArm:

@@ -14,17 +14,18 @@ pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
 @pytest.mark.parametrize("composed", [False, True], ids=["processes", "composed"])
 def test_realtime_loop_closes_at_rate(root, tmp_path, composed: bool) -> None:
-    """3 s at 1 kHz: 3000 ticks, commands labelled with their sample come back.
+    """3 s at 1 kHz: 3000 periods of the wall clock, commands labelled with their sample come back.
 
     The device starts ticking once the graph is up (``wait_for``), so the loop closes within its
     first cycles rather than whenever the other processes happen to finish starting. The share of
     commands arriving before the next tick is a benchmark (BENCHMARKS.md); the test only asserts
-    that the loop closes early (commands for at least 2700 of 3000 ticks, most of them on time)
+    that the loop closes early (commands for at least 90 % of the ticks that ran, most of them on
+    time; ticks a loaded machine missed are the device's overruns, counted apart)
     and that nothing is refused. Skips where the suite's capacity measurement says this machine
-    cannot turn this loop over fast enough for real time at 1 kHz now: the loop's work in
-    lockstep (``require_realtime``), and in four processes the raw DDS floor of the command's
-    path (device -> environment -> controller -> device: three hops, the slower of just before
-    and just after the run; ``require_hop_floor``), which no node can go under.
+    cannot carry this loop in real time at 1 kHz now: the CPU a cycle costs against what the
+    CPUs give a period (``require_realtime``), and in four processes the raw DDS floor of the
+    command's path (device -> environment -> controller -> device: three hops, the slower of
+    just before and just after the run; ``require_hop_floor``), which no node can go under.
     """
     loop = ["environment_node", "observer_node", "controller_node", "device_node"]
     # four processes: every message between them costs a process wake-up on each side (about
@@ -52,9 +53,9 @@ def test_realtime_loop_closes_at_rate(root, tmp_path, composed: bool) -> None:
     finally:
         graph.stop()
     s = json.loads(stats.read_text())
-    assert s["cycles"] == 3000
+    assert s["cycles"] + s["missed_ticks"] >= 3000  # 3 s of the wall clock's grid
     assert s["refused_commands"] == 0
-    assert s["commands_on_time"] + s["commands_late"] >= 2700, s
+    assert s["commands_on_time"] + s["commands_late"] >= 0.9 * s["cycles"], s
     if not composed:  # the DDS floor of the path's three hops, the slower side of the run
         hops.append(hop_floor_us())
         require_hop_floor(3, max(hops))

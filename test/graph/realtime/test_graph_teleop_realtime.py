@@ -3,21 +3,22 @@
 when the link dies (``channel.cut_at_s``) the master renders exactly zero force within the
 watchdog and the slave holds where it is. Bounds in samples.
 
-In real time each device ticks on its own clock, so the two sides' samples are apart by their
-start-up skew (each device starts once its own side is up and the other's device is built,
-``start_with``, plus what each still waits for): the slave's last message before the cut
-reaches the master at the master's sample ``C - 1 + max(delay, lag)``, where ``lag`` is how many
-samples the slave is behind the master when it sends that message (measured here from when the
-test's readers got both sides' link messages). The master's end then goes silent ``timeout``
-samples later (20 ms, 21 samples), as the batch run's does; the slave's end likewise with the
-master's lag. The upper bound allows ``SLACK`` samples for the hand-over and the lag's
-measurement.
+In real time each device ticks on its own clock and stamps its samples with the system clock, so a
+side's sample index is the whole periods since its first sample (as each channel end counts them,
+``SampleClock``), and the two sides' samples are apart by their start-up skew (each device starts
+once its own side is up and the other's device is built, ``start_with``, plus what each still waits
+for): the slave's last message before the cut reaches the master at the master's sample ``C - 1 +
+max(delay, lag)``, where ``lag`` is how many samples the slave is behind the master when it sends
+that message (measured here from when the test's readers got both sides' link messages). The
+master's end then goes silent ``timeout`` samples later (20 ms, 21 samples), as the batch run's
+does; the slave's end likewise with the master's lag. The upper bound allows ``SLACK`` samples for
+the hand-over and the lag's measurement.
 
-Skips where the suite's capacity measurement says this machine cannot turn the graph over fast
-enough for real time at 1 kHz now (``capacity.require_realtime_teleop``). A process per side
+Skips where the suite's capacity measurement says this machine cannot give a cycle of the graph
+the CPU it costs at 1 kHz now (``capacity.require_realtime_teleop``). A process per side
 (``--group master --group slave``) is not tested here: a stall of one process over the 20 ms
 watchdog makes the other end find its peer silent and then back, before any cut (seen once on
-this machine at a measured capacity over 1.2x).
+this machine when the old lockstep probe measured over 1.2x real time).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
 DURATION_S = 3.0
 CUT = 2000  # sample of the cut (channel.cut_at_s = 2 s at 1 kHz)
+PERIOD_NS = 1_000_000
 DELAY = 1  # samples each way (2 ms round trip)
 TIMEOUT = 20  # samples of channel.timeout_s (20 ms): silent 21 samples after the last arrival
 SLACK = 5  # samples: the hand-over to the next cycle and the lag's measurement
@@ -45,31 +47,38 @@ WAIT = {
 }
 
 
-def link(col: Collector, topic: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """A side's link messages: stamps (samples), receive times (s), peer silent, point (m)."""
+def index(stamp: int, origin: int) -> int:
+    """The sample index of a stamp of a side whose sample 0 is stamped ``origin`` (ns)."""
+    return (stamp - origin + PERIOD_NS // 2) // PERIOD_NS
+
+
+def link(col: Collector, topic: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+    """A side's link messages: samples, receive times (s), peer silent, point (m), and the stamp
+    of the side's sample 0 (its first message: the collector takes them all, reliably)."""
     times = np.array([t for t, _ in col.records[topic]])
     msgs = col.messages(topic)
-    k = np.array([stamp_ns(m) // 1_000_000 for m in msgs])
+    origin = stamp_ns(msgs[0])
+    k = np.array([index(stamp_ns(m), origin) for m in msgs])
     silent = np.array([m.position[4] != 0.0 for m in msgs])
     point = np.array([list(m.position[:3]) for m in msgs])
-    return k, times, silent, point
+    return k, times, silent, point, origin
 
 
 def lag_at(k_a: np.ndarray, t_a: np.ndarray, k_b: np.ndarray, t_b: np.ndarray) -> int:
     """How many samples side b is behind side a when b's last message before the cut (sample
     ``CUT - 1``) came: a's newest sample then, less ``CUT - 1`` (negative when b is ahead). A side
     slower than real time keeps falling behind, so this is the lag that says when a gets it."""
-    at = t_b[np.flatnonzero(k_b == CUT - 1)[0]]
+    at = t_b[np.flatnonzero(k_b < CUT)[-1]]  # CUT - 1, or the last before it (missed ticks)
     newest_a = k_a[: np.searchsorted(t_a, at, side="right")].max()
     return int(newest_a - (CUT - 1))
 
 
-def vectors(col: Collector, topic: str) -> dict[int, np.ndarray]:
-    """Stamp (samples) -> the message's 3-vector, first of each stamp."""
+def vectors(col: Collector, topic: str, origin: int) -> dict[int, np.ndarray]:
+    """Sample -> the message's 3-vector, first of each sample (``origin``: sample 0's stamp)."""
     out: dict[int, np.ndarray] = {}
     for m in col.messages(topic):
         vec = m.wrench.force if hasattr(m, "wrench") else m.pose.position
-        out.setdefault(stamp_ns(m) // 1_000_000, np.array([vec.x, vec.y, vec.z]))
+        out.setdefault(index(stamp_ns(m), origin), np.array([vec.x, vec.y, vec.z]))
     return out
 
 
@@ -100,13 +109,14 @@ def test_realtime_teleop_closes_the_loop_and_falls_back_on_a_dead_link(root, tmp
     # the loop closes at 1 kHz on both sides
     for ns, path in stats.items():
         s = json.loads(path.read_text())
-        assert s["cycles"] == 3000 and s["refused_commands"] == 0, (ns, s)  # both run to the end
+        # both run to the end of the wall clock's 3 s
+        assert s["cycles"] + s["missed_ticks"] >= 3000 and s["refused_commands"] == 0, (ns, s)
         assert s["commands_on_time"] + s["commands_late"] >= 0.9 * s["cycles"], (ns, s)
         assert s["on_time_pct"] > 50.0, (ns, s)
-    mk, mt, m_silent, _ = link(cols["master"], "/teleop/to_slave")
-    sk, st, s_silent, s_disp = link(cols["slave"], "/teleop/to_master")
-    rendered = vectors(cols["master"], "wrench_desired")
-    target = vectors(cols["slave"], "pose_desired")
+    mk, mt, m_silent, _, m0 = link(cols["master"], "/teleop/to_slave")
+    sk, st, s_silent, s_disp, s0 = link(cols["slave"], "/teleop/to_master")
+    rendered = vectors(cols["master"], "wrench_desired", m0)
+    target = vectors(cols["slave"], "pose_desired", s0)
     before = [k for k in rendered if k < CUT]
     assert any(np.any(rendered[k] != 0.0) for k in before), "no force came back"
     first = min(target)

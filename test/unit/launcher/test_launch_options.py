@@ -13,6 +13,7 @@ from haptic_dob.launcher.options import (
     network_env,
     normalize_namespace,
     parse_sets,
+    say_session,
 )
 
 
@@ -144,3 +145,14 @@ def test_discovery_stays_on_this_host_unless_asked() -> None:
         network_env("localhost", ["h1"])
     with pytest.raises(InputError, match="--network must be one of localhost, subnet"):
         network_env("wan", [])
+
+
+def test_the_launch_says_its_domain_and_discovery_then_the_command_authority(
+    monkeypatch, capsys
+) -> None:
+    monkeypatch.setenv("ROS_DOMAIN_ID", "42")
+    say_session(network_env("localhost", []), ["device_node takes effort_command ..."])
+    assert capsys.readouterr().err.splitlines() == [
+        "haptic-launch: domain 42, discovery localhost",
+        "haptic-launch: device_node takes effort_command ...",
+    ]

@@ -9,6 +9,7 @@ import pytest
 
 from haptic_dob.errors import InputError
 from haptic_dob.launcher.node_params import (
+    add_command_tokens,
     add_pinning,
     add_recorder,
     resolved_params,
@@ -170,6 +171,37 @@ def test_a_recorder_is_added_and_waited_for(tmp_path) -> None:
     (tmp_path / "bag").mkdir()
     with pytest.raises(InputError, match="it exists already; the recorder never overwrites a bag"):
         add_recorder({}, str(tmp_path / "bag"), "mcap")
+
+
+def test_a_device_and_its_controller_started_together_share_a_fresh_token() -> None:
+    params: dict = {"/**": {}, "device_node": {}, "controller_node": {}}
+    lines = add_command_tokens(params, LOOP)
+    token = params["device_node"]["command_token"]
+    assert len(token) == 16 and params["controller_node"]["command_token"] == token
+    assert lines == [
+        "device_node takes effort_command only from controller_node, by this launch's command token"
+    ]
+    again: dict = {"device_node": {}, "controller_node": {}}
+    add_command_tokens(again, LOOP)
+    assert again["device_node"]["command_token"] != token  # fresh at every launch
+    assert "command_token" not in params["/**"]
+
+
+def test_no_token_is_written_where_one_was_given_or_the_controller_starts_elsewhere() -> None:
+    given = {"/**": {"command_token": "shared"}, "device_node": {}, "controller_node": {}}
+    assert add_command_tokens(given, LOOP) == [
+        "device_node takes effort_command only from controller_node, by the command_token given"
+    ]
+    assert "command_token" not in given["device_node"]
+    split: dict = {"device_node": {}, "controller_node": {}}
+    (line,) = add_command_tokens(split, ["device_node"])  # --only device_node
+    assert "starts elsewhere: by its node name and GID in the graph" in line
+    assert "command_token" not in split["device_node"]
+    other = {"device_node": {"command_source": "/lab/pilot"}, "controller_node": {}}
+    assert "only from /lab/pilot, which starts elsewhere" in add_command_tokens(other, LOOP)[0]
+    opened = {"device_node": {"open_command_input": True}, "controller_node": {}}
+    assert "from any publisher (open_command_input)" in add_command_tokens(opened, LOOP)[0]
+    assert add_command_tokens({"controller_node": {}}, ["controller_node"]) == []  # no device
 
 
 def test_the_params_file_gives_every_node_its_section(tmp_path) -> None:

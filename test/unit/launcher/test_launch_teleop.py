@@ -8,6 +8,7 @@ import pytest
 import yaml
 
 from haptic_dob.errors import InputError
+from haptic_dob.launcher.node_params import add_command_tokens
 from haptic_dob.launcher.options import LaunchOptions
 from haptic_dob.launcher.teleop import (
     add_teleop_recorder,
@@ -36,6 +37,20 @@ def test_each_node_gets_its_sections_from_the_general_to_the_specific(sections, 
     assert slave["urdf_path"] == str(root / "config" / "urdf" / "arm7.urdf")  # beside the YAML
     assert params["master/channel_node"]["role"] == "master"
     assert params["slave/channel_node"]["channel.round_trip_delay_ms"] == 2.0
+
+
+def test_each_side_takes_its_commands_from_its_own_controller_by_one_token(sections) -> None:
+    params = teleop_params(sections, [])
+    assert params["slave/device_node"]["command_source"] == "slave_controller_node"
+    assert "command_source" not in params["master/device_node"]  # controller_node, the default
+    lines = add_command_tokens(params, list(params))
+    token = params["master/device_node"]["command_token"]
+    for name in ("master/controller_node", "slave/device_node", "slave/slave_controller_node"):
+        assert params[name]["command_token"] == token
+    assert lines == [
+        f"{ns}/device_node takes effort_command only from {source}, by this launch's command token"
+        for ns, source in (("master", "controller_node"), ("slave", "slave_controller_node"))
+    ]
 
 
 def test_a_realtime_side_does_not_wait_for_its_peer_unless_told(sections) -> None:

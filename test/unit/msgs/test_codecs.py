@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from haptic_msgs_py import cdr, codecs, wire
-from haptic_msgs_py.stamps import command_label
+from haptic_msgs_py.stamps import command_label, command_parts, command_stamp
 from haptic_msgs_py.values import EffortCommand, JointSample, Stamp, StampedVector
 
 frames = st.sampled_from(["", "a", "base_link", "abcdefgh", "ee_link_of_a_long_arm"])
@@ -64,6 +64,36 @@ def test_effort_commands_encode_as_rosbags_does_and_decode_back(stamp, effort) -
     encoded = codecs.EFFORT.encoder()(value)
     assert encoded == wire.encode(msg)
     assert codecs.EFFORT.decode(encoded) == value
+
+
+tokens = st.text(alphabet="0123456789abcdef#", max_size=16)
+
+
+@given(stamp=stamps, token=tokens, effort=st.lists(floats, max_size=7))
+@settings(max_examples=60, deadline=None)
+def test_an_effort_command_carries_its_senders_token_after_the_stamp(stamp, token, effort) -> None:
+    value = EffortCommand(stamp, tuple(effort), token)
+    encoded = codecs.EFFORT.encoder()(value)
+    assert encoded == wire.encode(wire.float64_multi_array(command_label(stamp, token), effort))
+    assert codecs.EFFORT.decode(encoded) == value
+    assert command_parts(command_label(stamp, token)) == (stamp, token)
+
+
+@pytest.mark.parametrize(
+    ("label", "parts"),
+    [
+        ("effort@5", (5, "")),
+        ("effort@5#tok", (5, "tok")),
+        ("effort@#tok", (None, "tok")),  # a token without a stamp: the newest command
+        ("effort@x#tok", (None, "tok")),
+        ("effort", (None, "")),
+        ("", (None, "")),
+        ("other@5#tok", (None, "")),  # not a command label: no stamp, no token
+    ],
+)
+def test_a_command_label_names_its_stamp_and_token(label: str, parts: tuple) -> None:
+    assert command_parts(label) == parts
+    assert command_stamp(label) == parts[0]
 
 
 def test_clock_encodes_as_rosbags_does() -> None:

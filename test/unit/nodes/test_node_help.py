@@ -21,6 +21,7 @@ NODES = [
     ("haptic_dob", "channel_node"),
     ("haptic_dob", "slave_controller_node"),
     ("haptic_dob", "recorder_node"),
+    ("haptic_dob", "bridge_node"),
 ]
 
 

@@ -15,14 +15,16 @@ def test_gaps_first_and_newest_stamps() -> None:
     for stamp in (5 * MS, 6 * MS, 9 * MS, 7 * MS, 2 * MS, 9 * MS):  # 7, 8 missing; 2 late
         c.wrote(stamp, MS)
     assert (c.written, c.gaps, c.first_ns, c.newest_ns) == (6, 2, 2 * MS, 9 * MS)
-    c.wrote(int(10.4 * MS), MS)  # within 1.5 periods: none missing
-    c.wrote(int(11.6 * MS), MS)  # more than 1.5 periods: rounds to one period, none missing
-    c.wrote(int(14.5 * MS), MS)  # ~3 periods: two missing
-    assert (c.gaps, c.newest_ns) == (4, int(14.5 * MS))
+    # system-clock stamps: each up to a period after its grid point (10, 11, 12 ...)
+    c.wrote(int(10.9 * MS), MS)  # late tick: none missing
+    c.wrote(int(11.0 * MS), MS)
+    c.wrote(int(12.95 * MS), MS)  # 1.95 periods after the last: a late tick, none missing
+    c.wrote(int(15.1 * MS), MS)  # 2.15 periods: grid point 14 was missed
+    assert (c.gaps, c.newest_ns) == (3, int(15.1 * MS))
     c.wrote(None, MS)  # an unstamped message is only counted
-    assert (c.written, c.gaps) == (10, 4)
-    c.received = 10
-    assert c.log_line() == "/ee_pose: received 10, written 10, 4 stamp(s) missing"
+    assert (c.written, c.gaps) == (11, 3)
+    c.received = 11
+    assert c.log_line() == "/ee_pose: received 11, written 11, 3 stamp(s) missing"
     assert TopicCount("/x", "t", 3, 3).log_line() == "/x: received 3, written 3"
 
 

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import pytest
 
-from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns
+from haptic_dob.bag.cdr import command_label_stamp_ns, header_stamp_ns, stamp_reader
 from haptic_dob.recorder.settings import DEFAULT_TOPICS
 from haptic_dob.recorder.topics import (
     PARAMETER_EVENT_TYPE,
     TopicEntry,
     TopicKind,
     parse_topics,
-    stamp_reader,
 )
 from haptic_msgs_py import wire
 from haptic_msgs_py.stamps import command_label
@@ -66,6 +65,8 @@ def test_stamps_are_read_from_the_bytes() -> None:
         command_label_stamp_ns
     )
     assert command_label_stamp_ns(wire.encode(cmd)) == 7_000_000
+    tokened = wire.float64_multi_array(command_label(7_000_000, "0123abcd"), [0.5])
+    assert command_label_stamp_ns(wire.encode(tokened)) == 7_000_000  # a sender's token after it
     assert command_label_stamp_ns(wire.encode(wire.float64_multi_array("x", [0.5]))) is None
     assert stamp_reader("/parameter_events", PARAMETER_EVENT_TYPE) is None
     assert stamp_reader("/other", "std_msgs/msg/Float64MultiArray") is None

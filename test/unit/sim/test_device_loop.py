@@ -62,6 +62,7 @@ def test_the_statistics_keep_the_stats_file_keys_and_are_nan_before_a_command() 
         "commands_late",
         "on_time_pct",
         "missed_ticks",
+        "overruns",
         "latency_p50_ms",
         "latency_p99_ms",
         "refused_commands",
@@ -72,12 +73,14 @@ def test_the_statistics_keep_the_stats_file_keys_and_are_nan_before_a_command() 
     json.dumps(asdict(result))  # what the node writes
 
 
-def test_a_loop_more_than_a_period_behind_resynchronises_and_counts_the_missed_ticks() -> None:
+def test_a_tick_a_period_late_is_an_overrun_and_the_grid_points_it_passed_are_missed() -> None:
     stats = RealtimeStats()
-    assert stats.next_deadline(10.0, 10.0015, 0.001) == pytest.approx(10.001)  # on schedule
-    assert stats.missed_ticks == 0
-    assert stats.next_deadline(10.0, 10.0045, 0.001) == pytest.approx(10.0055)  # resynchronised
-    assert stats.missed_ticks == 3
+    assert stats.tick_at(0, 0.00105, 0.001) == 1  # on time
+    assert stats.tick_at(1, 0.0029, 0.001) == 2  # late, but within the period: no overrun
+    assert (stats.overruns, stats.missed_ticks) == (0, 0)
+    assert stats.tick_at(2, 0.0055, 0.001) == 5  # a period and more late: points 3 and 4 passed
+    assert (stats.overruns, stats.missed_ticks) == (1, 2)
+    assert stats.tick_at(5, 0.0049, 0.001) == 6  # never before the next point
 
 
 # --- recorder gate ---------------------------------------------------------------------------
@@ -174,17 +177,28 @@ def values(**changes: Any) -> dict[str, Any]:
     return {**v, **changes}
 
 
+class Clock:
+    """A system clock that the test sets (ns)."""
+
+    def __init__(self, now_ns: int = 1_790_000_000_123_456_789) -> None:
+        self.now_ns = now_ns
+
+    def __call__(self) -> int:
+        return self.now_ns
+
+
 def make_loop(
-    lockstep: bool, last_k: int | None = None, **changes: Any
+    lockstep: bool, last_k: int | None = None, clock: Clock | None = None, **changes: Any
 ) -> tuple[DeviceLoop, Port, Log]:
     v = values(**changes)
     port, log = Port(), Log()
-    return DeviceLoop(build_device(v), port, log, v, lockstep, last_k), port, log
+    loop = DeviceLoop(build_device(v), port, log, v, lockstep, last_k, clock or Clock())
+    return loop, port, log
 
 
-def started(lockstep: bool, last_k: int | None = None, **changes: Any):
+def started(lockstep: bool, last_k: int | None = None, clock: Clock | None = None, **changes: Any):
     """A loop whose graph is up and which has sent sample 0."""
-    loop, port, log = make_loop(lockstep, last_k, **changes)
+    loop, port, log = make_loop(lockstep, last_k, clock, **changes)
     loop.wakeup(0.0)  # the graph is up: settle for start_delay_s (none in real time alone)
     if not loop.started:
         loop.wakeup(loop.deadline)
@@ -193,7 +207,10 @@ def started(lockstep: bool, last_k: int | None = None, **changes: Any):
 
 
 def command(loop: DeviceLoop, effort: float, stamped: bool = True) -> None:
-    stamp = loop.device.k * loop.period_ns if stamped else None
+    """A command labelled with the current sample's stamp (or unlabelled)."""
+    stamp = (
+        (loop.device.k * loop.period_ns if loop.lockstep else loop.stamp_ns) if stamped else None
+    )
     loop.command(EffortCommand(stamp, (effort,)))
 
 
@@ -334,12 +351,49 @@ def test_a_trip_soon_after_another_is_said_late_not_lost() -> None:
     loop.tick(said_at + 1.0)
     assert log.lines[1] == (
         "warning",
-        "watchdog: no valid effort_command for 6 samples (limit 5 ms of simulated time): effort "
+        "watchdog: no valid effort_command for 6 samples (limit 5 ms of samples sent): effort "
         "zeroed (2 trips so far)",
     )
     command(loop, 1.0)
     loop.shutdown()  # the news of the last moment is said, however soon after the line before
     assert log.lines[2] == ("info", "valid effort_command again: effort resumed (after trip 2)")
+
+
+def test_realtime_follows_the_wall_clock_and_a_late_tick_does_not_slow_time() -> None:
+    """Each sample carries the system clock when it was taken; a tick 3.4 periods late is one
+    overrun and three missed ticks (4, 5, 6), the plant steps one period with the held command,
+    and the next tick is due on the grid again. The watchdog counts the samples sent, so the
+    device's own stall does not trip it. A run of N periods ends at grid point N, however many
+    ticks were missed."""
+    clock = Clock()
+    loop, port, log = started(lockstep=False, last_k=9, clock=clock, wait_for=[])
+    t0, stamp0 = loop.t_first, clock.now_ns
+    assert port.sent[0].stamp_ns == stamp0 == loop.stamp_ns
+    t = t0 + 0.001
+    for k in range(1, 4):  # on time, the system clock a little after each grid point
+        command(loop, 1.0)
+        clock.now_ns = stamp0 + k * 1_000_000 + 70_000
+        loop.wakeup(t)
+        assert port.sent[-1].k == k and port.sent[-1].stamp_ns == clock.now_ns
+        t = loop.deadline
+        assert t == pytest.approx(t0 + (k + 1) * 0.001)
+    command(loop, 2.0)  # command 3, then the device's process stalls
+    clock.now_ns = stamp0 + 7_400_000
+    loop.wakeup(t0 + 0.0074)
+    s = port.sent[-1]
+    assert (s.k, s.stamp_ns, s.effort) == (4, clock.now_ns, (2.0,))
+    assert loop.grid == 7 and loop.deadline == pytest.approx(t0 + 0.008)
+    stats = loop.stats()
+    assert (stats.overruns, stats.missed_ticks, stats.cycles, stats.watchdog_trips) == (1, 3, 4, 0)
+    assert stats.commands_on_time == 4 and stats.commands_late == 0
+    command(loop, 3.0)  # labelled with the newest sample's stamp: on time
+    assert loop.realtime.on_time == 5
+    for grid in (8, 9):  # the run of 9 periods ends at grid point 9, sample 6
+        clock.now_ns = stamp0 + grid * 1_000_000 + 50_000
+        loop.wakeup(loop.deadline)
+    assert port.sent[-1].k == 6 and loop.recorders.draining
+    assert log.said("finished: 6 cycles (0.006 s simulated)") == 1
+    assert log.said("3 ticks missed in 1 overruns") == 1
 
 
 def test_realtime_shutdown_runs_one_last_period_at_zero_effort() -> None:
@@ -361,7 +415,7 @@ def test_wait_for_names_a_node_here_or_anywhere_by_its_full_name() -> None:
     """A plain ``wait_for`` name is a node of the device's namespace; ``/rosbag2_recorder``
     (``ros2 bag record``'s node, in the root namespace) waits for a recorder of a namespaced
     session."""
-    from haptic_sim.device.settings import missing_nodes
+    from haptic_dob.nodes.common import missing_nodes
 
     graph = [("controller_node", "/slide1"), ("rosbag2_recorder", "/"), ("probe", "/lab/a")]
     wait_for = ["controller_node", "/rosbag2_recorder", "/lab/a/probe"]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from haptic_sim.device.latency import LatencyHistogram
+from haptic_dob.runtime.latency import LatencyHistogram
 
 
 def test_percentiles_match_numpy_to_one_bin() -> None:

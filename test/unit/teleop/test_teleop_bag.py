@@ -4,6 +4,8 @@ recorded graph itself against the batch run: test_graph_teleop_bag.py."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 
 from haptic_dob.bag.errors import BagError
@@ -57,6 +59,18 @@ def test_the_config_is_the_nodes_recorded_parameters(root) -> None:
     )
     with pytest.raises(BagError, match="lacks the parameters of /slave/channel_node"):
         session_config(events_of(sections, drop="/slave/channel_node"), "bag")
+
+
+def test_a_real_time_recording_is_refused_in_one_line(root) -> None:
+    """Each side of a real-time graph stamps its samples by its own system clock."""
+    sections = load_teleop_sections(root / "config" / "teleop_sim.yaml")
+    events = events_of(sections)
+    device = next(e for e in events if e.node == "/master/device_node")
+    events[events.index(device)] = dataclasses.replace(
+        device, values={**device.values, "clock_mode": "realtime"}
+    )
+    with pytest.raises(BagError, match=r"a real-time recording .* record the session in lockstep"):
+        session_config(events, "bag")
 
 
 def test_a_bag_of_one_loop_is_refused_in_one_line(tmp_path, capsys) -> None:

@@ -301,3 +301,32 @@ def test_the_momentum_observer_finds_a_tip_force_with_one_lag_on_every_joint() -
     np.testing.assert_allclose(est[310, 1:], [3.0 * 0.63, -4.0 * 0.63], atol=0.15)
     np.testing.assert_allclose(est[400:], np.tile([0.0, 3.0, -4.0], (400, 1)), atol=0.1)
     np.testing.assert_allclose(dob.wrench(np.array(arm.sample().q)), [0.0, 3.0, -4.0], atol=0.1)
+
+
+def test_the_ends_count_samples_of_system_clock_stamps_as_of_lockstep_stamps() -> None:
+    """Real-time devices stamp with the system clock when they take a sample (a period apart,
+    give or take their wake-up jitter, each side from its own start): each end counts the
+    whole periods since a side's first stamp, so a cut link, the delay and the watchdog come at
+    the same samples as with lockstep's ``k * T`` stamps (``cut_at_s`` from the start, not from
+    1970)."""
+    rng = np.random.default_rng(3)
+    runs = []
+    for wall in (False, True):
+        master, slave = ends(round_trip_delay_ms=4.0, cut_at_s=0.05, timeout_s=0.005)
+        t_m, t_s = (1_790_000_000_000_123_456, 1_790_000_000_003_400_000) if wall else (0, 0)
+        out = []
+        for k in range(100):
+            jitter = rng.integers(0, 4 * PERIOD // 10, size=2) if wall else (0, 0)
+            fw, to_slave = master.cycle(
+                t_m + k * PERIOD + int(jitter[0]), (0.001 * k, 0.0, 0.0), (1.0, 0.0, 0.0)
+            )
+            here = (0.5, 0.0, 0.4 - 0.0001 * k)
+            target, to_master = slave.cycle(
+                t_s + k * PERIOD + int(jitter[1]), here, (0.0, 0.0, 0.0), (0.0, 0.0, 5.0)
+            )
+            slave.receive(to_slave)
+            master.receive(to_master)
+            out.append((fw, target, master.peer_silent, slave.peer_silent))
+        runs.append(out)
+    assert runs[0] == runs[1]
+    assert runs[1][40][2] is False and runs[1][99][2] is True  # the cut (50) came, at its sample

@@ -5,7 +5,8 @@ The simulated session graph for the ROS 2 command line, the same plan as ``hapti
 observer, controller) in one process (``ros2 run haptic_dob container``, their messages handed
 over in process) unless ``composed:=false``, in ``namespace``. Every process is required: when
 the device finishes a lockstep run (``duration_s``) or any node process ends (a crash, a kill),
-the launch shuts the whole graph down, as ``haptic-launch`` does.
+the launch shuts the whole graph down, as ``haptic-launch`` does. The device and its controller
+share a fresh command token (``command_token``), as under ``haptic-launch``.
 
 It starts no recorder (``haptic-launch --record`` does). To record, start one first in its own
 terminal (``ros2 run haptic_dob recorder_node --ros-args -p output:=BAG``, or ``ros2 bag record``
@@ -23,7 +24,14 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 from haptic_dob.runtime.configs import resolve_config
-from haptic_dob.launcher import NODES, START_ORDER, groups_for, resolved_params, write_params_file
+from haptic_dob.launcher import (
+    NODES,
+    START_ORDER,
+    add_command_tokens,
+    groups_for,
+    resolved_params,
+    write_params_file,
+)
 from haptic_dob.nodes.registry import CONTAINER
 
 
@@ -46,6 +54,8 @@ def _nodes(context, *args, **kwargs):
         for g in groups_for(names, False, composed == "false", ())
         if len(g) > 1
     ]
+    # a device and its controller started here share a fresh command token
+    add_command_tokens(params, names)
     # one params file for every process, removed when the launch ends
     folder = Path(tempfile.mkdtemp(prefix="haptic-launch-"))
     params_file = str(write_params_file(params, folder))

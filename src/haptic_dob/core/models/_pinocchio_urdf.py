@@ -1,20 +1,17 @@
 """URDF arms for pinocchio: parse, choose the joints, lock the rest (pinocchio's API stays here).
 
-What a real arm's description holds and how it is used:
-
 - revolute and prismatic joints: one coordinate each;
-- continuous joints (pinocchio's ``RUB`` joints, configuration ``(cos, sin)``): one coordinate,
-  the angle, as a joint state carries it (``PinocchioModel`` maps angles to pinocchio's
-  configuration with ``pinocchio.integrate`` from the neutral configuration);
-- mimic joints (a gripper's second finger): pinocchio's own mimic joints, which follow their
-  master; they are never coordinates of their own, and move with their master when it is chosen
-  (else they are locked with it);
-- fixed joints: merged into their links by the parser;
-- meshes (``package://``, relative paths): never read (dynamics need none);
+- continuous joints (pinocchio's ``RUB``, configuration ``(cos, sin)``): one coordinate, the
+  angle as a joint state carries it (``PinocchioModel`` maps angles to the configuration with
+  ``pinocchio.integrate`` from the neutral configuration);
+- mimic joints: pinocchio's own, following their master, never coordinates of their own (they
+  move with their master when it is chosen, else they are locked with it);
+- fixed joints: merged into their links; meshes: never read;
 - floating, planar and other multi-DOF joints: refused with the joint's name when they would be
-  a coordinate (leave them out of ``joint_names`` to lock them).
+  a coordinate (left out of ``joint_names`` they are locked).
 
-Every joint that is not chosen is locked at its neutral position (zero angle or offset).
+Every joint that is not chosen is locked at its neutral position (zero angle or offset). What a
+real arm's description holds and how it is used: docs/models.md, "PHANToM 1.5 and URDF arms".
 """
 
 from __future__ import annotations
@@ -154,3 +151,15 @@ def urdf_model(
     damping = tuple(float(model.damping[i]) for i in idx_v)
     friction = tuple(float(model.friction[i]) for i in idx_v)
     return UrdfArm(model, frame_id(model, tip_frame), tuple(wanted), S, limits, damping, friction)
+
+
+def add_payload(model: pin.Model, frame: int, mass_kg: float) -> None:
+    """Put a point mass of ``mass_kg`` (kg, >= 0) at frame ``frame``'s origin, on the body that
+    carries it (a handle, a tool, a sensor the URDF does not have). Before any ``Data``."""
+    if not (math.isfinite(mass_kg) and mass_kg >= 0.0):
+        raise ValueError(f"payload_kg must be finite and >= 0, got {mass_kg!r}")
+    if mass_kg == 0.0:
+        return
+    f = model.frames[frame]
+    point = pin.Inertia(float(mass_kg), f.placement.translation.copy(), np.zeros((3, 3)))
+    model.appendBodyToJoint(f.parentJoint, point, pin.SE3.Identity())

@@ -1,6 +1,8 @@
 """Build the device model a node or a batch run names by parameters (``model`` + its group).
 
 - ``slide``: ``slide.*`` (``SlideParams``).
+- ``point_mass``: ``point_mass.*`` (``PointMassParams``): a Cartesian point mass per axis (Force
+  Dimension devices).
 - ``phantom``: ``phantom.params`` (``appendix_b`` | ``cavusoglu``), ``phantom.gravity``,
   ``phantom.viscous_n_m_s_per_rad`` (``PhantomSettings``).
 - ``urdf``: ``robot_description`` (URDF text, the ROS convention) or ``urdf_path``, ``tip_frame``,
@@ -16,11 +18,12 @@ from typing import Any
 
 from haptic_dob.core.models.base import DeviceModel
 from haptic_dob.core.models.phantom import PhantomSettings
+from haptic_dob.core.models.point_mass import PointMassParams
 from haptic_dob.core.models.slide import SlideParams
 from haptic_dob.core.models.urdf import UrdfOptions, UrdfSettings
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 
-MODEL_KINDS = ("slide", "phantom", "urdf")
+MODEL_KINDS = ("slide", "point_mass", "phantom", "urdf")
 
 
 def model_specs() -> list[ParamSpec]:
@@ -28,6 +31,7 @@ def model_specs() -> list[ParamSpec]:
     return [
         ParamSpec("model", "slide", "device model", choices=MODEL_KINDS, read_only=True),
         *specs_of(SlideParams, "slide.", read_only=True),
+        *specs_of(PointMassParams, "point_mass.", read_only=True),
         *specs_of(PhantomSettings, "phantom.", read_only=True),
         *specs_of(UrdfSettings, "", read_only=True),
         *specs_of(UrdfOptions, "urdf.", read_only=True),
@@ -42,6 +46,8 @@ def build_model(values: Mapping[str, Any]) -> DeviceModel:
     kind = values.get("model", "slide")
     if kind == "slide":
         return build(SlideParams, values, "slide.").model()
+    if kind == "point_mass":
+        return build(PointMassParams, values, "point_mass.").model()
     if kind == "phantom":
         return build(PhantomSettings, values, "phantom.").model()
     if kind == "urdf":

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from haptic_dob.core.models._pinocchio import PinocchioModel
-from haptic_dob.core.models._pinocchio_urdf import urdf_model
+from haptic_dob.core.models._pinocchio_urdf import add_payload, urdf_model
 from haptic_dob.runtime.params import param
 
 
@@ -28,12 +28,10 @@ class UrdfModel(PinocchioModel):
         tip_frame: the link or frame whose origin is the end-effector point.
         joint_names: the joints to use, in this order (default: the chain to ``tip_frame``).
         gravity: False leaves gravity out of the model.
-        viscous: viscous joint friction (N m s/rad or N s/m), scalar or per joint; None: each
-            joint's ``<dynamics damping>`` from the URDF (0 where it has none).
-        coulomb: Coulomb joint friction (N m or N), scalar or per joint; None: each joint's
-            ``<dynamics friction>`` from the URDF.
-        coulomb_speed: the speed (rad/s or m/s) over which the Coulomb friction turns, scalar or
-            per joint: ``Fc tanh(q' / v_c)``; 0 (the default): ``Fc sgn(q')``.
+        viscous, coulomb: joint friction (N m s/rad or N s/m; N m or N), scalar or per joint; None:
+            each joint's ``<dynamics damping>`` / ``<dynamics friction>`` from the URDF (0 if none).
+        coulomb_speed: v_c (rad/s or m/s) of ``Fc tanh(q' / v_c)``, scalar or per joint; 0: sgn(q').
+        payload_kg: a point mass (kg) at ``tip_frame``'s origin that the URDF does not have.
 
     Raises ``ValueError`` with a clear message for a bad URDF, an unknown frame or joint, or a
     joint that cannot be a coordinate (floating, planar, a mimic joint named in ``joint_names``).
@@ -49,10 +47,13 @@ class UrdfModel(PinocchioModel):
         viscous: float | Sequence[float] | None = None,
         coulomb: float | Sequence[float] | None = None,
         coulomb_speed: float | Sequence[float] = 0.0,
+        payload_kg: float = 0.0,
     ) -> None:
         if not str(tip_frame):
             raise ValueError("tip_frame must name a frame of the URDF, got ''")
         arm = urdf_model(urdf, str(tip_frame), joint_names)
+        add_payload(arm.model, arm.frame_id, payload_kg)
+        self.payload_kg = float(payload_kg)
         self.tip_frame = str(tip_frame)
         #: per-joint effort limits from the URDF's <limit effort=...> (0 where none)
         self.effort_limits = arm.effort_limits
@@ -70,7 +71,7 @@ class UrdfModel(PinocchioModel):
     def __repr__(self) -> str:
         return (
             f"UrdfModel(tip_frame={self.tip_frame!r}, joint_names={list(self.joint_names)}, "
-            f"gravity={self.gravity_enabled})"
+            f"gravity={self.gravity_enabled}, payload_kg={self.payload_kg})"
         )
 
 
@@ -112,6 +113,7 @@ class UrdfSettings:
             viscous=_friction(opts.viscous_n_m_s_per_rad),
             coulomb=_friction(opts.coulomb_n_m),
             coulomb_speed=_friction(opts.coulomb_speed_rad_per_s) or 0.0,
+            payload_kg=opts.payload_kg,
         )
 
 
@@ -161,5 +163,14 @@ class UrdfOptions:
             "rad/s",
             0.0,
             10.0,
+        ),
+    )
+    payload_kg: float = field(
+        default=0.0,
+        metadata=param(
+            "a point mass at tip_frame's origin that the URDF does not have (a handle, a tool)",
+            "kg",
+            0.0,
+            100.0,
         ),
     )

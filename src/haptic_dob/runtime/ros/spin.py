@@ -5,6 +5,9 @@ in a loop that watches a signal flag does, and lets nodes do their shutdown work
 zeroes its effort) before the context goes. Nodes may ask to be woken at a time
 (``next_wakeup``) for real-time ticks, and may say they are ``finished``.
 
+An exception out of any node's callback ends the process, but first every node's
+``on_shutdown`` runs (``last_words``): a device or a bridge to a real driver sends its zero.
+
 Nothing published is lost at a clean stop: a process whose nodes all report a ``drain_marker``
 (the observer) first works off the inputs still coming, until the marker stops changing for
 ``DRAIN_QUIET_S``, for at most ``WORK_OFF_S`` (off the lockstep critical path, the observer may be
@@ -44,12 +47,14 @@ from haptic_dob.runtime.cpu_latency import NO_REQUEST, hold, strictest
 from haptic_dob.runtime.cpus import checked_cpus, pin_process
 from haptic_dob.runtime.ros.dds_profile import use_default_profile
 from haptic_dob.runtime.ros.log import LoopLog
+from haptic_dob.runtime.ros_args import shadow_line, shadowed
 from haptic_msgs_py.bus import bus_for
 
 EXECUTORS = ("events", "single")
 DRAIN_BUDGET_S = 2.0  # at most this long for the work-off and the acknowledgements at a stop
 DRAIN_QUIET_S = 0.2  # inputs are worked off when the marker did not change for this long
 WORK_OFF_S = 0.5  # ... or after this long
+LAST_WORDS_S = 0.5  # after an error: how long the zero's acknowledgement may take
 #: while nodes of this process hand the loop around in process (lockstep), the executor (DDS
 #: from other processes, services, timers) gets a turn at least this often (s)
 SOON_SLICE_S = 0.004
@@ -157,6 +162,16 @@ def hold_asked_cpu_latency(nodes: Sequence[Node]) -> int | None:
     return fd
 
 
+def say_shadowed(nodes: Sequence[Node], argv: Sequence[str]) -> None:
+    """Each node says, in one line, which ``-p`` values of ``argv`` a params file's section
+    overrode for it, and what to type instead (``haptic_dob.runtime.ros_args``)."""
+    for node in nodes:
+        fqn = node.get_fully_qualified_name()
+        found = shadowed(argv, fqn)
+        if found:
+            node.get_logger().warning(shadow_line(found, fqn))
+
+
 def run_over(nodes: Sequence[LoopNode]) -> bool:
     """Whether the spin loop stops: a node finished with an error or without ending a run of its
     own, or every node that ends its run by itself (``finishes_run``) has finished."""
@@ -192,9 +207,10 @@ def run_nodes(
     kind = executor or os.environ.get("HAPTIC_DOB_EXECUTOR", "events")
     use_default_profile()
     context = Context()
+    argv = list(args) if args is not None else sys.argv
     try:
         rclpy.init(
-            args=list(args) if args is not None else sys.argv,
+            args=argv,
             context=context,
             signal_handler_options=SignalHandlerOptions.NO,
         )
@@ -224,6 +240,7 @@ def run_nodes(
             nodes = list(make_nodes(context))
             pin_to_asked_cpus(nodes)
             latency_fd = hold_asked_cpu_latency(nodes)
+            say_shadowed(nodes, argv)
         except InvalidParameterValueException as exc:
             text = " ".join(str(exc).split())  # "... Reason: <reason>: <name>"
             reason, _, name = (text.partition("Reason: ")[2] or text).rpartition(": ")
@@ -248,28 +265,32 @@ def run_nodes(
         spin_once = ex.spin_once
         monotonic = time.monotonic
         bus = bus_for(context)
-        while not received and context.ok():
-            if run_over(loop_nodes):
-                break
-            now = monotonic()
-            timeout = 0.05
-            due_nodes = False
-            for n in loop_nodes:
-                due = n.next_wakeup()
-                if due is not None:
-                    due_nodes = True
-                    timeout = min(timeout, due - now)
-            if bus.soon:  # nodes composed here turn the loop over in process (lockstep)
-                bus.run_soon(SOON_SLICE_S)
-                spin_once(timeout_sec=0.0)  # then the executor gets a turn
-            elif timeout > 0.0:
-                spin_once(timeout_sec=timeout)
-            if due_nodes:
+        try:
+            while not received and context.ok():
+                if run_over(loop_nodes):
+                    break
                 now = monotonic()
+                timeout = 0.05
+                due_nodes = False
                 for n in loop_nodes:
                     due = n.next_wakeup()
-                    if due is not None and due <= now:
-                        n.on_wakeup(now)
+                    if due is not None:
+                        due_nodes = True
+                        timeout = min(timeout, due - now)
+                if bus.soon:  # nodes composed here turn the loop over in process (lockstep)
+                    bus.run_soon(SOON_SLICE_S)
+                    spin_once(timeout_sec=0.0)  # then the executor gets a turn
+                elif timeout > 0.0:
+                    spin_once(timeout_sec=timeout)
+                if due_nodes:
+                    now = monotonic()
+                    for n in loop_nodes:
+                        due = n.next_wakeup()
+                        if due is not None and due <= now:
+                            n.on_wakeup(now)
+        except Exception:
+            last_words(loop_nodes)  # an error in any node: a device's zero still goes out
+            raise
         if profile_dir:
             prof.disable()
             prof.dump_stats(os.path.join(profile_dir, f"{nodes[0].get_name()}.prof"))
@@ -290,6 +311,18 @@ def run_nodes(
             os.close(latency_fd)
         for s, h in old.items():
             signal.signal(s, h)
+
+
+def last_words(nodes: Sequence[LoopNode]) -> None:
+    """Each node's ``on_shutdown`` after an error ended the spin loop (a device or a bridge
+    zeroes its effort), whatever else fails meanwhile; then a short wait for the readers'
+    acknowledgements."""
+    for n in nodes:
+        try:
+            n.on_shutdown()
+        except Exception as exc:  # the error that ended the loop is raised next
+            print(f"ERROR: {n.get_name()}: shutdown after an error failed: {exc}", file=sys.stderr)
+    wait_for_acknowledgements(nodes, time.monotonic() + LAST_WORDS_S)
 
 
 def work_off(spin_once: Callable[..., None], nodes: Sequence[LoopNode], until: float) -> None:

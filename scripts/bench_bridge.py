@@ -1,0 +1,107 @@
+"""The device bridge's latency: a test driver's state to its command, against the raw DDS hop.
+
+Each run starts a test driver (``test/support/drivers``: the forcedimension_ros2-like one at
+1 kHz, the Touch-like one at 500 Hz with best-effort states and the stylus button held) and
+``haptic-launch`` of its config (``bridge_forcedimension``, ``bridge_touch``: the bridge composed
+with the loop, OL wall, the hand pushing into it) for ``RUN_S`` seconds on a fresh domain id,
+and measures one raw hop (``dds_hop``) just before and just after it. The driver measures what
+matters to a device: from publishing state k to receiving command k (two hops and the loop), and
+whether command k arrived before it published state k+1 (on time). The figure is that latency's
+median against the slower raw hop of the run: the floor is two hops.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "test"))  # the test drivers live with the tests
+
+from haptic_dob.runtime.ros.dds_hop import hop_us  # noqa: E402
+from support.drivers.run import SLIDE_HAND, Controls, Truth, start  # noqa: E402
+
+RUN_S = 10.0
+PROFILES = {
+    "fd": (
+        "bridge_forcedimension.yaml",
+        {"kind": "fd", "rate_hz": 1000.0, "hand": SLIDE_HAND, "hand_axis": 0},
+    ),
+    "touch": (
+        "bridge_touch.yaml",
+        {
+            "kind": "touch",
+            "rate_hz": 500.0,
+            "hand": {**SLIDE_HAND, "offset_m": 0.012},
+            "hand_direction": [0, 0, -1],
+        },
+    ),
+}
+
+
+def one_run(profile: str) -> dict[str, float]:
+    """One session of ``profile``: the driver's counts, the bridge's, and the raw hops."""
+    config, driver = PROFILES[profile]
+    domain = random.randint(101, 200)
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    hop_before = hop_us(2000, domain_id=domain)
+    with tempfile.TemporaryDirectory(prefix="bench-bridge-") as tmp:
+        d = Path(tmp)
+        drv = start(driver, env, d / "driver")
+        controls = Controls(env, "/touch") if profile == "touch" else None
+        argv = [str(Path(sys.executable).parent / "haptic-launch"), str(ROOT / "config" / config)]
+        argv += ["--namespace", "/haptic", "--set", f"bridge_node:duration_s={RUN_S}"]
+        argv += ["--set", f"bridge_node:stats_file={d / 'bridge.json'}"]
+        graph = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        try:
+            if controls is not None:
+                time.sleep(3.0)  # the bridge is up: the user holds the stylus's button
+                controls.press(True)
+            out, _ = graph.communicate(timeout=RUN_S + 120)
+        finally:
+            if controls is not None:
+                controls.close()
+            drv.stop()
+        if graph.returncode != 0:
+            raise RuntimeError(f"haptic-launch failed: {out.decode()[-1500:]}")
+        truth = Truth.read(d / "driver")
+        bridge = json.loads((d / "bridge.json").read_text())
+    hop_after = hop_us(2000, domain_id=domain)
+    c = truth.counts
+    return {
+        "hop_us": max(hop_before, hop_after),
+        "latency_p50_us": c["latency_p50_ms"] * 1e3,
+        "latency_p99_us": c["latency_p99_ms"] * 1e3,
+        "on_time_pct": 100.0 * c["commands_on_time"] / (c["commands_on_time"] + c["commands_late"]),
+        "bridge_p50_us": bridge["latency_p50_ms"] * 1e3,
+        "ticked_pct": 100.0 * truth.ticked_share(),
+    }
+
+
+def bench_bridge(repeat: int) -> str:
+    """Driver state -> command latency through the bridge (composed) against one raw hop."""
+    parts = []
+    for profile in PROFILES:
+        runs = [one_run(profile) for _ in range(repeat)]
+        med = {k: statistics.median(r[k] for r in runs) for k in runs[0]}
+        ratio = [r["latency_p50_us"] / r["hop_us"] for r in runs]
+        on_time = ", ".join(f"{r['on_time_pct']:.2f}" for r in runs)
+        ticked = ", ".join(f"{r['ticked_pct']:.0f}" for r in runs)
+        parts.append(
+            f"{profile}: state->command p50 {med['latency_p50_us']:.0f} us "
+            f"(p99 {med['latency_p99_us']:.0f}), {statistics.median(ratio):.1f}x one raw hop "
+            f"({med['hop_us']:.0f} us; floor 2x), inside the bridge {med['bridge_p50_us']:.0f} "
+            f"us; on time {on_time} %; driver ticked {ticked} % of its periods"
+        )
+    return "; ".join(parts)
+
+
+if __name__ == "__main__":
+    print(bench_bridge(int(sys.argv[1]) if len(sys.argv) > 1 else 1))

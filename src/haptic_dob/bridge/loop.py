@@ -1,0 +1,273 @@
+"""The bridge's cycle, ROS-free: a driver state to the loop, the loop's command to the driver.
+
+``on_state`` turns driver state k into the loop's sample k (q, q', the effort in force over
+[k-1, k), the tip's point and velocity from the model's kinematics, the driver's stamp);
+``on_command`` turns the loop's command for it into the driver's at once (``CommandMap``,
+``CommandLimiter``). Every way out is zero:
+
+- before ``start``, after ``stop``, and while the dead-man is released or never seen: zero on
+  every state;
+- no valid command for ``safety.command_timeout_s`` (in driver states): zero until one comes;
+- no state for ``state.timeout_s`` (wall clock, ``on_wakeup``): zero, again every timeout, and
+  no command for the last state is taken;
+- a command of the wrong length or with NaN/inf is refused (zero); one for a sample older than
+  the newest answered, or not handed on, is dropped; nothing non-finite is sent. docs/safety.md.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Callable
+from typing import NamedTuple
+
+import numpy as np
+
+from haptic_dob.bridge.command import CommandLimiter, CommandMap
+from haptic_dob.bridge.driver_settings import DriverSettings
+from haptic_dob.bridge.settings import SafetySettings
+from haptic_dob.bridge.state import DriverState
+from haptic_dob.core.models.base import DeviceModel
+from haptic_dob.core.watchdog import CommandWatchdog
+from haptic_dob.runtime.latency import LatencyHistogram
+from haptic_msgs_py.stamps import period_ns
+from haptic_msgs_py.values import EffortCommand
+
+Vec3 = tuple[float, float, float]
+
+
+class LoopSample(NamedTuple):
+    """Driver state k in the suite's contract (SI, model joint order, the driver's stamp)."""
+
+    stamp_ns: int
+    q: tuple[float, ...]
+    qd: tuple[float, ...]
+    effort: tuple[float, ...]  # in force over [k-1, k)
+    ee_position: Vec3
+    ee_velocity: Vec3
+
+
+class Send(NamedTuple):
+    """A command for the driver: its elements in the driver's units, the sample it answers
+    (ns; the newest state's for a zero), and why it is zero ('' for the loop's command)."""
+
+    values: tuple[float, ...]
+    stamp_ns: int
+    zero_because: str
+
+
+def _quiet(_text: str) -> None:
+    """Say nothing."""
+
+
+class BridgeLoop:
+    """One driver's bridge to the loop (see the module's notes).
+
+    Args:
+        driver: the driver's settings (``DriverSettings.of``).
+        safety: the clamp, rate limit, command timeout and dead-man.
+        model: the device model the loop uses (its kinematics give the tip's point).
+        driver_joints: the driver's name of each model joint (``StateReader.driver_joints``).
+        rate_hz: the driver's rate (Hz).
+        say: where the loop says a trip or a resumption (once each).
+    """
+
+    def __init__(
+        self,
+        driver: DriverSettings,
+        safety: SafetySettings,
+        model: DeviceModel,
+        driver_joints: tuple[str, ...],
+        rate_hz: float,
+        say: Callable[[str], None] = _quiet,
+    ) -> None:
+        self.model = model
+        self.map = CommandMap(driver, model, driver_joints)
+        n = self.map.size
+        self.period_s = period_ns(rate_hz) * 1e-9
+        self.limiter = CommandLimiter(safety.limits_for(n), safety.rates_for(n), self.period_s)
+        self.scale = driver.command.scale
+        self.command_timeout_s = safety.command_timeout_s
+        self.state_timeout_s = driver.state.timeout_s
+        self.effort_source = driver.effort
+        self.watchdog = CommandWatchdog(period_ns(rate_hz), self._tripped, self._resumed)
+        self._say = say
+        self._zero_model = (0.0,) * model.dof
+        self._sent_model = self._zero_model  # model efforts of the newest command sent
+        self._in_force: deque[tuple[float, ...]] = deque(maxlen=driver.delay_samples + 1)
+        self.deadman_held = safety.deadman == "none"
+        self.started = False
+        self.stopping = False
+        self.state_stale = False
+        self.state_deadline: float | None = None  # monotonic s: no state by then trips
+        self.k = 0  # states handed on
+        self.newest_ns = -1  # stamp of the newest state handed on
+        self.answered_ns = -1  # stamp of the newest sample commanded
+        self._newest_q: tuple[float, ...] = self._zero_model
+        self._newest_t = 0.0
+        self.latency = LatencyHistogram()  # s, state arrival -> its command sent
+        self.states = self.on_time = self.late = 0
+        self.refused = self.dropped = self.gated = self.zeros = 0
+        self.state_trips = self.deadman_releases = self.repeated = 0
+
+    # --- the driver's state --------------------------------------------------------------
+    def on_state(self, s: DriverState, now: float) -> tuple[LoopSample | None, Send | None]:
+        """Driver state ``s`` arrived at monotonic ``now`` (s): the loop's sample (None while
+        not handing on) and a zero to send first (None when none is due)."""
+        if self.stopping:
+            return None, None
+        if s.stamp_ns <= self.newest_ns:  # a stamp that did not advance: not a new state
+            self.repeated += 1
+            if self.repeated == 1:
+                self._say(
+                    "the driver's state stamps do not advance (a state stamped "
+                    f"{s.stamp_ns} after {self.newest_ns}): such states are not handed on; "
+                    "state.stamp: receipt stamps them on arrival"
+                )
+            return None, None
+        self.states += 1
+        self.state_deadline = now + self.state_timeout_s
+        if self.state_stale:
+            self.state_stale = False
+            self._say("driver state again: the loop resumes")
+        self._in_force.append(self._sent_model)
+        if not self.started:
+            return None, self._zero(s.stamp_ns, "the loop is not up yet")
+        if self.answered_ns != self.newest_ns and self.on_time + self.late:
+            self.late += 1  # the previous state got no command before this one
+        self.k += 1
+        self.newest_ns, self._newest_q, self._newest_t = s.stamp_ns, s.q, now
+        zero = None
+        if self.watchdog.due(self.k, self.command_timeout_s):
+            zero = self._zero(s.stamp_ns, "no loop command")
+        elif not self.deadman_held:
+            zero = self._zero(s.stamp_ns, "dead-man released")
+        return self._sample(s), zero
+
+    def _sample(self, s: DriverState) -> LoopSample:
+        if self.effort_source == "driver":
+            if s.effort is None:
+                raise ValueError(
+                    "the driver's state has no effort (state.effort must be commanded)"
+                )
+            effort = s.effort
+        else:
+            full = len(self._in_force) == self._in_force.maxlen
+            effort = self._in_force[0] if full else self._zero_model
+        q = np.asarray(s.q, dtype=np.float64)
+        p = self.model._forward_kinematics(q)
+        v = self.model._jacobian(q) @ np.asarray(s.qd, dtype=np.float64)
+        return LoopSample(s.stamp_ns, s.q, s.qd, effort, (p[0], p[1], p[2]), (v[0], v[1], v[2]))
+
+    # --- the loop's command ----------------------------------------------------------------
+    def on_command(self, cmd: EffortCommand, now: float) -> Send | None:
+        """The loop's command arrived at monotonic ``now`` (s): the driver's command, a zero
+        (refused), or None (dropped: stale, blocked, or after the stop)."""
+        if self.stopping:
+            return None
+        stamp = self.newest_ns if cmd.stamp_ns is None else cmd.stamp_ns
+        if not self.started or self.state_stale or not self.answered_ns < stamp <= self.newest_ns:
+            self.dropped += 1
+            return None
+        tau = cmd.effort
+        if len(tau) != self.model.dof or not all(map(math.isfinite, tau)):
+            self.refused += 1
+            return self._zero(stamp, "refused a command of the wrong length or with NaN/inf")
+        self.watchdog.fed(self.k)
+        self.answered_ns = stamp
+        if stamp == self.newest_ns:
+            self.on_time += 1
+            self.latency.add(now - self._newest_t)
+        if not self.deadman_held:
+            self.gated += 1
+            return None
+        u = self.limiter.limit(self.map.forward(tau, self._newest_q))
+        if not all(map(math.isfinite, u)):  # a singular map, say: never sent
+            self.refused += 1
+            return self._zero(stamp, "the command mapped to NaN/inf")
+        self._sent_model = self.map.back(u, self._newest_q)
+        return Send(tuple(x * self.scale for x in u), stamp, "")
+
+    # --- safety inputs and time -------------------------------------------------------------
+    def on_deadman(self, held: bool) -> Send | None:
+        """The dead-man is ``held`` now: released sends zero at once."""
+        was, self.deadman_held = self.deadman_held, held
+        if was and not held:
+            self.deadman_releases += 1
+            self._say("dead-man released: zero command until it is held again")
+            return self._zero(self.newest_ns, "dead-man released")
+        if held and not was:
+            self._say("dead-man held: the loop's commands pass")
+        return None
+
+    def on_wakeup(self, now: float) -> Send | None:
+        """The state watchdog at monotonic ``now`` (s): zero when the driver's state stopped."""
+        if self.stopping or self.state_deadline is None or now < self.state_deadline:
+            return None
+        self.state_deadline = now + self.state_timeout_s
+        if not self.state_stale and self.started:
+            self.state_stale = True
+            self.state_trips += 1
+            self.answered_ns = self.newest_ns  # no command for the stale state is taken
+            self._say(
+                f"no driver state for {self.state_timeout_s * 1e3:g} ms: zero command, the "
+                f"stale state is not rendered ({self.state_trips} trips so far)"
+            )
+        return self._zero(self.newest_ns, "no driver state")
+
+    def start(self) -> None:
+        """Hand the driver's states to the loop from the next one on."""
+        self.started = True
+
+    def stop(self) -> Send:
+        """The end: zero now, nothing after."""
+        self.stopping = True
+        return self._zero(self.newest_ns, "stopping")
+
+    # --- what goes out as zero ----------------------------------------------------------------
+    def _zero(self, stamp_ns: int, why: str) -> Send:
+        self.zeros += 1
+        self._sent_model = self._zero_model
+        return Send(self.limiter.zero(), max(stamp_ns, 0), why)
+
+    def _tripped(self, held: str) -> None:
+        self._say(
+            f"watchdog: no valid loop command for {held} (limit "
+            f"{self.command_timeout_s * 1e3:g} ms): zero command ({self.watchdog.trips} trips)"
+        )
+
+    def _resumed(self) -> None:
+        self._say("loop command again: the driver's command resumes")
+
+    def status(self) -> str:
+        """Why the driver gets zero now ('' when the loop's commands pass)."""
+        if not self.started:
+            return "waiting for the loop"
+        if self.state_stale:
+            return "no driver state"
+        if self.watchdog.tripped:
+            return "no loop command"
+        return "" if self.deadman_held else "dead-man released"
+
+    def counts(self) -> dict[str, float]:
+        """What the bridge counted so far (the stats file and the diagnostics)."""
+        total = self.on_time + self.late
+        return {
+            "states": self.states,
+            "handed_on": self.k,
+            "commands_on_time": self.on_time,
+            "commands_late": self.late,
+            "on_time_pct": 100.0 * self.on_time / total if total else math.nan,
+            "latency_p50_ms": self.latency.percentile(50) * 1e3,
+            "latency_p99_ms": self.latency.percentile(99) * 1e3,
+            "refused_commands": self.refused,
+            "dropped_commands": self.dropped,
+            "gated_commands": self.gated,
+            "clamped_commands": self.limiter.clamped,
+            "rate_limited_commands": self.limiter.slowed,
+            "zeros_sent": self.zeros,
+            "watchdog_trips": self.watchdog.trips,
+            "state_trips": self.state_trips,
+            "deadman_releases": self.deadman_releases,
+            "states_not_advancing": self.repeated,
+        }

@@ -1,0 +1,150 @@
+"""A driver's state as the model's joint vectors: joints by name, signs, units, velocity.
+
+``StateReader`` turns one driver message (a ``JointState``'s fields, or a pose's position) into
+the model's q and q' (and the driver's effort, where it reports one): joints matched by name in
+any order with extra joints ignored (``core.joint_states.JointMap``), each multiplied by its sign
+and the unit scale; a pose's axes permuted and signed (``frame.*``). Velocity is the driver's
+where it gives one and the settings take it, else the backward difference of the positions over
+the stamps' interval, low-passed (``VelocityFilter``). Anything unusable raises ``ValueError``
+naming it; nothing is kept from a refused message.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from haptic_dob.bridge.driver_settings import FrameSettings, StateSettings
+from haptic_dob.bridge.settings import per_element
+from haptic_dob.core.joint_states import JointMap, pick
+from haptic_dob.core.models.base import DeviceModel
+from haptic_msgs_py.stamps import NS_PER_S
+
+
+class DriverState(NamedTuple):
+    """One driver sample in the model's joint order (SI): stamp (ns), q, q', and the effort
+    the driver reports (``None``: it reports none)."""
+
+    stamp_ns: int
+    q: tuple[float, ...]
+    qd: tuple[float, ...]
+    effort: tuple[float, ...] | None
+
+
+class VelocityFilter:
+    """Backward difference of positions over the stamps' interval, then a first-order low-pass
+    (``alpha = 1 - exp(-2 pi fc dt)``; ``fc = 0``: unfiltered). The first sample's velocity is
+    zero; an interval <= 0 or over ``max_gap_s`` restarts the filter from that sample."""
+
+    def __init__(self, cutoff_hz: float, max_gap_s: float) -> None:
+        self.cutoff_hz = cutoff_hz
+        self.max_gap_s = max_gap_s
+        self._q: tuple[float, ...] | None = None
+        self._stamp = 0
+        self._v: list[float] = []
+
+    def update(self, stamp_ns: int, q: Sequence[float]) -> tuple[float, ...]:
+        """The velocity (per s) at sample ``stamp_ns`` with positions ``q``."""
+        prev, self._q = self._q, tuple(q)
+        dt = (stamp_ns - self._stamp) / NS_PER_S
+        self._stamp = stamp_ns
+        if prev is None or not 0.0 < dt <= self.max_gap_s:
+            self._v = [0.0] * len(q)
+            return tuple(self._v)
+        raw = [(a - b) / dt for a, b in zip(q, prev, strict=True)]
+        if self.cutoff_hz <= 0.0:
+            self._v = raw
+        else:
+            alpha = 1.0 - math.exp(-2.0 * math.pi * self.cutoff_hz * dt)
+            self._v = [v + alpha * (r - v) for v, r in zip(self._v, raw, strict=True)]
+        return tuple(self._v)
+
+    def reset(self) -> None:
+        """Forget the history: the next sample starts again from zero velocity."""
+        self._q = None
+
+
+def check_cartesian(model: DeviceModel) -> None:
+    """``ValueError`` unless ``model``'s joints are the tip's point (a pose state's model)."""
+    x = np.array([0.01, -0.02, 0.03])
+    if model.dof != 3 or not (
+        np.allclose(model._forward_kinematics(x), x) and np.allclose(model._jacobian(x), np.eye(3))
+    ):
+        raise ValueError("state.type pose needs a Cartesian model (q = the tip's point)")
+
+
+class StateReader:
+    """Reads a driver's states into the model's joint order (``DriverState``).
+
+    Args:
+        state: the state settings (topic type, joints, signs, scale, velocity source).
+        frame: the driver's axes against the model's base frame (pose states).
+        model_joints: the model's joint names, in order.
+        period_s: the driver's nominal period (the difference restarts after 5 of them).
+    """
+
+    def __init__(
+        self,
+        state: StateSettings,
+        frame: FrameSettings,
+        model_joints: Sequence[str],
+        period_s: float,
+    ) -> None:
+        n = len(model_joints)
+        names = [s for s in state.joints if s]
+        if names and len(names) != n:
+            raise ValueError(
+                f"state.joints names {len(names)} joints for the model's {n} "
+                f"({', '.join(model_joints)})"
+            )
+        self.driver_joints = tuple(names or model_joints)
+        self.signs = per_element("state.signs", state.signs, n, positive=False)
+        self.scale = state.scale
+        self.source = state.velocity
+        self.pose = state.type == "pose"
+        if self.pose and n != 3:
+            raise ValueError(f"state.type pose needs a 3-axis Cartesian model, not {n} joints")
+        self.axes = tuple(frame.axes)
+        self.axis_signs = tuple(frame.signs)
+        self._map = JointMap(self.driver_joints)
+        self._gain = [s * self.scale for s in self.signs]
+        self.velocity = VelocityFilter(state.velocity_cutoff_hz, 5.0 * period_s)
+
+    def joints(
+        self, stamp_ns: int, names: Sequence[str], position: Any, velocity: Any, effort: Any
+    ) -> DriverState:
+        """A ``JointState``'s fields in model order; ``ValueError`` for a missing joint, a field
+        of the wrong length, or NaN/inf."""
+        idx = self._map.index(names, len(position))
+        count = len(names) or len(position)
+        gain = self._gain
+        q = tuple(g * x for g, x in zip(gain, pick(position, idx, "position", count), strict=True))
+        given = len(velocity) > 0 and self.source != "difference"
+        if self.source == "driver" and not len(velocity):
+            raise ValueError("the state has no velocity (state.velocity is driver)")
+        if given:
+            vel = pick(velocity, idx, "velocity", count)
+            qd = tuple(g * v for g, v in zip(gain, vel, strict=True))
+        tau = None
+        if len(effort):
+            tau = tuple(
+                s * e for s, e in zip(self.signs, pick(effort, idx, "effort", count), strict=True)
+            )
+        values = q + (qd if given else ()) + (tau or ())
+        if not all(map(math.isfinite, values)):
+            raise ValueError("the state holds NaN or inf")
+        if not given:
+            qd = self.velocity.update(stamp_ns, q)
+        return DriverState(stamp_ns, q, qd, tau)
+
+    def position(self, stamp_ns: int, xyz: Sequence[float]) -> DriverState:
+        """A pose's position (driver axes) as the Cartesian model's q; q' differenced."""
+        if not all(map(math.isfinite, xyz)):
+            raise ValueError("the pose holds NaN or inf")
+        q = tuple(
+            s * self.scale * float(xyz[a]) for a, s in zip(self.axes, self.axis_signs, strict=True)
+        )
+        return DriverState(stamp_ns, q, self.velocity.update(stamp_ns, q), None)

@@ -1,0 +1,222 @@
+"""A test driver: a real driver's topics over a simulated plant, on the wall clock, truth kept.
+
+``python test/support/drivers/node.py CONFIG.json`` runs one driver until SIGINT/SIGTERM, then
+writes ``truth.json`` (the plant's hidden parameters, what the driver counted, its last command)
+and ``series.npz`` (per cycle: stamp, positions, the effort applied, the true hand force, the tip;
+per command: arrival, the state answered, values) into the config's ``out`` directory.
+
+Config keys: ``kind`` (``fd``, ``touch``, ``arm``), ``rate_hz``, ``seed``, ``out``, ``hand``
+(``HandParams`` fields), ``hand_axis`` (fd), ``hand_direction`` (touch), ``button`` (touch: the
+white button held from the start), ``table_z`` (arm). Test controls in the driver's namespace:
+``test/pause`` (``std_msgs/Float64``: publish no state for that many seconds, the plant and the
+commands going on) and ``test/button`` (``std_msgs/Bool``, touch: the white button).
+
+The cycle is the driver's: at tick k+1 the plant moves over [k, k+1) with the effort in force
+(ros2_control: the command written at tick k; Touch: the newest force, on arrival), then state
+k+1 goes out stamped with the system clock. Command k is on time when it answers state k and
+arrives before tick k+1.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from rclpy.context import Context
+from std_msgs.msg import String
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # ``support`` when run as a file
+
+from haptic_dob.runtime.latency import LatencyHistogram
+from haptic_dob.runtime.ros.spin import LoopNode, run_nodes
+from haptic_msgs_py.ros.raw import raw_subscription
+from haptic_msgs_py.stamps import period_ns
+from support.drivers import plants
+from support.drivers.speak import LATCHED, Ros2Control, Touch
+
+TICKING = "ticking"  # the driver's first line once it ticks (``run.start`` waits for it)
+ARM_JOINTS = tuple(f"joint{i}" for i in range(1, 8))
+GRIPPER = "gripper_finger_joint"  # an extra joint the arm's model does not have
+FD_JOINTS = ("fd_x", "fd_y", "fd_z")
+#: the Touch driver's axes against the model's base: driver (x, y, z) = model (x, z, -y)
+TOUCH_FROM_MODEL = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+
+
+class DriverNode(LoopNode):
+    """One test driver (``kind`` of the config) ticking its plant on the wall clock."""
+
+    def __init__(self, cfg: dict[str, Any], context: Context) -> None:
+        self.kind = cfg["kind"]
+        super().__init__(f"{self.kind}_driver", context=context)
+        self.cfg = cfg
+        rate = float(cfg["rate_hz"])
+        seed = int(cfg.get("seed", 0))
+        self.period_s = period_ns(rate) * 1e-9
+        hand = cfg.get("hand", {"behaviour": "none"})
+        ns = {"fd": "/fd", "touch": "/touch", "arm": "/arm"}[self.kind]
+        self.plant: Any
+        if self.kind == "fd":
+            self.plant = plants.cartesian_slides(rate, seed, hand, int(cfg.get("hand_axis", 0)))
+            self.io: Any = Ros2Control(self, ns, "fd_controller", FD_JOINTS, FD_JOINTS, self._got)
+            self.names = FD_JOINTS
+        elif self.kind == "arm":
+            self.plant = plants.arm7(rate, seed, float(cfg.get("table_z", 0.39)))
+            assert self.plant.arm.model.joint_names == ARM_JOINTS
+            shuffled = [*ARM_JOINTS, GRIPPER]
+            random.Random(seed).shuffle(shuffled)
+            self.names = tuple(shuffled)
+            self.io = Ros2Control(self, ns, "effort_controller", self.names, ARM_JOINTS, self._got)
+            pub = self.create_publisher(String, f"{ns}/robot_description", LATCHED)
+            pub.publish(String(data=(plants.ROOT / "config" / "urdf" / "arm7.urdf").read_text()))
+        else:
+            direction = tuple(cfg.get("hand_direction", (0.0, 0.0, -1.0)))
+            self.plant = plants.phantom(rate, seed, hand, direction)
+            self.io = Touch(self, ns, self._got)
+            self.names = Touch.JOINTS
+            raw_subscription(
+                self, "std_msgs/msg/Bool", f"{ns}/test/button", self._on_button, LATCHED
+            )
+        raw_subscription(self, "std_msgs/msg/Float64", f"{ns}/test/pause", self._on_pause, LATCHED)
+        self._button = bool(cfg.get("button", False))
+        self._written = tuple(0.0 for _ in range(self.plant.dof))  # effort in force (plant joints)
+        self._force = np.zeros(3)  # touch: the Cartesian force in force (model axes)
+        self.deadline = time.monotonic() + 0.2
+        self.paused_until = 0.0
+        self._k = -1
+        self._stamp = 0  # the newest state's stamp
+        self._t_sent = 0.0
+        self._answered = -1  # the newest stamp a command answered on time
+        self.on_time = self.late = self.missed_ticks = self.states = 0
+        self.latency = LatencyHistogram()
+        #: per tick: stamp, monotonic s, published (1/0), q..., effort..., hand (3), tip (3)
+        self.ticks: list[tuple[float, ...]] = []
+        self.commands: list[tuple[float, ...]] = []  # arrival (monotonic), stamp, values...
+        self.tick_stamps: list[int] = []  # each tick's stamp, exact (ns)
+        self.answered: list[int] = []  # the stamp each command answers, exact (-1: none)
+        self.last_command: tuple[float, ...] = ()
+
+    # --- inputs ------------------------------------------------------------------------------
+    def _got(self, stamp_ns: int | None, values: tuple[float, ...]) -> None:
+        now = time.monotonic()
+        self.last_command = values
+        self.commands.append((now, float(-1 if stamp_ns is None else stamp_ns), *values))
+        self.answered.append(-1 if stamp_ns is None else stamp_ns)
+        if stamp_ns == self._stamp and self._answered != self._stamp:
+            self._answered = self._stamp
+            self.on_time += 1
+            self.latency.add(now - self._t_sent)
+
+    def _on_button(self, msg: Any) -> None:
+        self._button = bool(msg.data)
+
+    def _on_pause(self, msg: Any) -> None:
+        self.paused_until = time.monotonic() + float(msg.data)
+
+    # --- the cycle ---------------------------------------------------------------------------
+    def next_wakeup(self) -> float | None:
+        return self.deadline
+
+    def on_wakeup(self, now: float) -> None:
+        if self._k < 0:
+            self.get_logger().info(f"{TICKING} at {self.cfg['rate_hz']} Hz")
+        if self._k >= 0:
+            if self._answered != self._stamp and self.on_time:
+                self.late += 1
+            self.plant.apply(self._effort())
+        self._k += 1
+        s = self.plant.sample()
+        stamp = time.time_ns()
+        if self.kind == "touch":
+            self.io.press(self._button, stamp)
+        published = now >= self.paused_until
+        if published:
+            self._publish(stamp, s)
+        if self.kind == "fd" or self.kind == "arm":
+            self._written = self.io.update()  # the controller's update: acts from this tick on
+        applied = self._force if self.kind == "touch" else s.effort
+        row = (stamp, now, float(published), *s.q, *applied, *s.hand_force, *s.ee_position)
+        self.ticks.append(row)
+        self.tick_stamps.append(stamp)
+        self.deadline += self.period_s
+        if now - self.deadline > self.period_s:
+            self.missed_ticks += int((now - self.deadline) / self.period_s)
+            self.deadline = now + self.period_s
+        self.plant.prepare()
+
+    def _publish(self, stamp: int, s: Any) -> None:
+        self._stamp, self._t_sent = stamp, time.monotonic()
+        self.states += 1
+        if self.kind == "touch":
+            self.io.publish(stamp, s.q)
+        elif self.kind == "fd":
+            self.io.publish(stamp, self.names, s.q, s.qd, s.effort)
+        else:
+            by_name = dict(zip(ARM_JOINTS, zip(s.q, s.qd, s.effort, strict=True), strict=True))
+            by_name[GRIPPER] = (0.04, 0.0, 0.0)
+            q, qd, e = zip(*(by_name[n] for n in self.names), strict=True)
+            self.io.publish(stamp, self.names, q, qd, e)
+
+    def _effort(self) -> tuple[float, ...]:
+        """The plant's joint effort over the coming period, the driver's way."""
+        if self.kind == "fd":
+            return self._written
+        if self.kind == "arm":  # as a Franka: the commanded torque rides on the robot's own
+            by_name = dict(zip(self.io.command_joints, self._written, strict=True))  # gravity
+            g = self.plant.gravity()  # compensation
+            return tuple(by_name[n] + gi for n, gi in zip(ARM_JOINTS, g, strict=True))
+        F = TOUCH_FROM_MODEL.T @ np.asarray(self.io.gated_force)  # model axes
+        norm = float(np.linalg.norm(F))
+        if norm > plants.TOUCH_MAX_FORCE_N:
+            F *= plants.TOUCH_MAX_FORCE_N / norm
+        self._force = F
+        J = self.plant.model._jacobian(np.asarray(self.plant.sample().q))
+        return tuple((J.T @ F).tolist())
+
+    # --- the end -------------------------------------------------------------------------------
+    def on_shutdown(self) -> None:
+        out = Path(self.cfg["out"])
+        out.mkdir(parents=True, exist_ok=True)
+        counts = {
+            "states": self.states,
+            "ticks": self._k,
+            "commands": len(self.commands),
+            "commands_on_time": self.on_time,
+            "commands_late": self.late,
+            "missed_ticks": self.missed_ticks,
+            "latency_p50_ms": self.latency.percentile(50) * 1e3,
+            "latency_p99_ms": self.latency.percentile(99) * 1e3,
+            "nonfinite_dropped": self.io.nonfinite_dropped,
+            "size_errors": getattr(self.io, "size_errors", 0),
+        }
+        truth = {
+            "kind": self.kind,
+            "rate_hz": self.cfg["rate_hz"],
+            "plant": self.plant.truth(),
+            "counts": counts,
+            "last_command": list(self.last_command),
+            "names": list(self.names),
+        }
+        (out / "truth.json").write_text(json.dumps(truth, indent=2, default=float))
+        np.savez(
+            out / "series.npz",
+            ticks=np.array(self.ticks, dtype=np.float64),
+            commands=np.array(self.commands, dtype=np.float64),
+            tick_stamps=np.array(self.tick_stamps, dtype=np.int64),
+            answered=np.array(self.answered, dtype=np.int64),
+            dof=self.plant.dof,
+        )
+
+
+def main(argv: list[str]) -> int:
+    """Run the driver of the config file ``argv[1]`` until a signal."""
+    cfg = json.loads(Path(argv[1]).read_text())
+    return run_nodes(lambda ctx: [DriverNode(cfg, ctx)], ["driver"])
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,167 @@
+"""Start a test driver from a test, work its controls, read its truth.
+
+``start`` writes the driver's config and starts ``drivers/node.py`` as a process of its own
+(``rosgraph.Process``: its own session, stopped by SIGINT, killed if it lingers). ``Controls``
+holds one publisher per test control (transient local, so a message sent before the driver
+matched still arrives): the stylus button, a pause of the state. ``Truth`` reads what the driver
+wrote when it stopped.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from support.rosgraph import Process
+from support.waits import wait_until
+
+NODE = Path(__file__).resolve().parent / "node.py"
+
+#: a hand like slide_sim's: a 2 N push with a slow semi-random swing, held by a soft grip
+SLIDE_HAND = {
+    "behaviour": "semi_random",
+    "mass_kg": 0.1,
+    "stiffness_n_per_m": 300.0,
+    "damping_n_s_per_m": 10.0,
+    "offset_m": 0.0091667,
+    "amplitude_m": 0.0011458,
+    "band_low_hz": 0.05,
+    "band_high_hz": 10.0,
+    "ramp_s": 1.0,
+}
+
+
+def start(cfg: dict[str, Any], env: dict[str, str], directory: Path) -> Process:
+    """The driver of ``cfg`` (``node.py``'s keys; ``out`` defaults to ``directory``), ticking
+    (its start-up may take seconds on a loaded machine: a session started before would run
+    without it)."""
+    directory.mkdir(parents=True, exist_ok=True)
+    cfg = {"out": str(directory), **cfg}
+    path = directory / "driver.json"
+    path.write_text(json.dumps(cfg))
+    proc = Process([sys.executable, str(NODE), str(path)], env, directory / "driver.log")
+    if not wait_until(lambda: "ticking" in proc.output() or proc.proc.poll() is not None, 120.0):
+        proc.stop()
+        raise TimeoutError(f"the test driver did not start ticking:\n{proc.output()[-2000:]}")
+    assert proc.proc.poll() is None, proc.output()[-2000:]
+    return proc
+
+
+class Controls:
+    """The test's hand on a driver: its controls in namespace ``ns`` (a private context)."""
+
+    def __init__(self, env: dict[str, str], ns: str) -> None:
+        import rclpy
+        from rclpy.context import Context
+        from std_msgs.msg import Bool, Float64
+
+        from support.drivers.speak import LATCHED
+
+        self._saved = {
+            k: os.environ.get(k) for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")
+        }
+        os.environ["ROS_DOMAIN_ID"] = env["ROS_DOMAIN_ID"]
+        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = env["ROS_AUTOMATIC_DISCOVERY_RANGE"]
+        self.context = Context()
+        rclpy.init(context=self.context, args=[])
+        self.node = rclpy.create_node(
+            "test_hand", context=self.context, start_parameter_services=False
+        )
+        self._bool, self._float = Bool, Float64
+        self._button = self.node.create_publisher(Bool, f"{ns}/test/button", LATCHED)
+        self._pause = self.node.create_publisher(Float64, f"{ns}/test/pause", LATCHED)
+
+    def press(self, held: bool) -> None:
+        """Hold (or let go of) the stylus's white button."""
+        self._button.publish(self._bool(data=held))
+
+    def pause(self, seconds: float) -> None:
+        """The driver publishes no state for ``seconds``."""
+        self._pause.publish(self._float(data=seconds))
+
+    def close(self) -> None:
+        import rclpy
+
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+        for k, v in self._saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+@dataclass(frozen=True)
+class Truth:
+    """What a driver wrote when it stopped: its counts and plant, and per cycle and command
+    series (``ticks``: stamp ns, monotonic s, whether the state went out, q, the effort applied
+    over the period before, hand force (3), tip (3); ``commands``: arrival (monotonic s), the
+    stamp answered, values)."""
+
+    info: dict[str, Any]
+    ticks: np.ndarray
+    commands: np.ndarray
+    dof: int
+    stamps: np.ndarray  # each tick's stamp (ns, int64)
+    answered: np.ndarray  # the stamp each command answers (ns, int64; -1: none)
+
+    @classmethod
+    def read(cls, directory: Path) -> Truth:
+        info = json.loads((directory / "truth.json").read_text())
+        data = np.load(directory / "series.npz")
+        return cls(
+            info,
+            data["ticks"],
+            data["commands"],
+            int(data["dof"]),
+            data["tick_stamps"],
+            data["answered"],
+        )
+
+    @property
+    def counts(self) -> dict[str, Any]:
+        return dict(self.info["counts"])
+
+    @property
+    def times(self) -> np.ndarray:
+        """Monotonic s of each tick (the test's clock too)."""
+        return self.ticks[:, 1]
+
+    @property
+    def published(self) -> np.ndarray:
+        return self.ticks[:, 2] > 0.5
+
+    @property
+    def q(self) -> np.ndarray:
+        return self.ticks[:, 3 : 3 + self.dof]
+
+    @property
+    def applied(self) -> np.ndarray:
+        """The effort applied over the period before each tick (joints; the Touch's Cartesian
+        force in the model's axes)."""
+        n = 3 if self.info["kind"] == "touch" else self.dof
+        return self.ticks[:, 3 + self.dof : 3 + self.dof + n]
+
+    def ticked_share(self) -> float:
+        """The driver's ticks over the periods of its life: 1 when it held its rate (a Python
+        test driver on a loaded machine falls behind, which a real driver would not)."""
+        periods = (self.times[-1] - self.times[0]) * float(self.info["rate_hz"])
+        return (len(self.times) - 1) / periods if periods > 0 else 0.0
+
+    def tick_of(self, stamp_ns: int) -> int:
+        """The index of the tick whose state carried ``stamp_ns``."""
+        return int(np.searchsorted(self.stamps, stamp_ns))
+
+    @property
+    def hand(self) -> np.ndarray:
+        return self.ticks[:, -6:-3]
+
+    @property
+    def tip(self) -> np.ndarray:
+        return self.ticks[:, -3:]

@@ -1,0 +1,160 @@
+"""The bridge's cycle without ROS: state k to the loop, command k to the driver, and every way
+out of it zero (the watchdogs, the dead-man, refused commands, the stop)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from haptic_dob.bridge.driver_settings import DriverSettings
+from haptic_dob.bridge.loop import BridgeLoop
+from haptic_dob.bridge.settings import SafetySettings
+from haptic_dob.bridge.state import DriverState
+from haptic_dob.core.models.urdf import UrdfModel
+from haptic_msgs_py.values import EffortCommand
+from support.paths import ROOT
+
+FD = ("fd_x", "fd_y", "fd_z")
+T = 1_000_000  # ns: 1 kHz
+
+
+def model() -> UrdfModel:
+    return UrdfModel(ROOT / "config" / "urdf" / "fd_cartesian.urdf", "fd_tip", gravity=False)
+
+
+def bridge(delay: int = 0, **safety: object) -> BridgeLoop:
+    driver = DriverSettings.of(
+        {"state.topic": "s", "command.topic": "c", "command.delay_samples": delay}
+    )
+    s = SafetySettings(**{"command_limits": [5.0], "rate_limit": [0.0], **safety})  # type: ignore[arg-type]
+    return BridgeLoop(driver, s.check(), model(), FD, 1000.0)
+
+
+def state(k: int, x: float = 0.0) -> DriverState:
+    return DriverState(k * T, (x, 0.0, 0.0), (0.0, 0.0, 0.0), None)
+
+
+def cmd(k: int | None, *effort: float) -> EffortCommand:
+    return EffortCommand(None if k is None else k * T, effort or (1.0, 0.0, 0.0))
+
+
+def test_zero_until_the_loop_is_up_then_sample_and_command_at_once() -> None:
+    b = bridge()
+    sample, zero = b.on_state(state(1), 0.0)
+    assert sample is None and zero is not None and zero.values == (0.0, 0.0, 0.0)
+    assert b.on_command(cmd(1), 0.0) is None  # not handed on: dropped
+    b.start()
+    sample, zero = b.on_state(state(2, 0.01), 0.001)
+    assert zero is None and sample is not None
+    assert sample.stamp_ns == 2 * T and sample.ee_position == pytest.approx((0.01, 0.0, 0.0))
+    send = b.on_command(cmd(2, 2.0, -1.0, 9.0), 0.0012)
+    assert send is not None and send.values == (2.0, -1.0, 5.0) and send.stamp_ns == 2 * T
+    assert b.limiter.clamped == 1 and b.on_time == 1
+
+
+@pytest.mark.parametrize("delay", [0, 1])
+def test_the_effort_of_k_minus_1_to_k_is_what_was_in_force(delay: int) -> None:
+    """Delay 0: the newest command sent before state k came; 1 (ros2_control): the one before."""
+    b = bridge(delay)
+    b.start()
+    efforts = []
+    for k in range(1, 5):
+        sample, _ = b.on_state(state(k), k * 1e-3)
+        assert sample is not None
+        efforts.append(sample.effort[0])
+        b.on_command(cmd(k, float(k), 0.0, 0.0), k * 1e-3)
+    assert efforts == ([0.0, 1.0, 2.0, 3.0] if delay == 0 else [0.0, 0.0, 1.0, 2.0])
+
+
+def test_the_command_watchdog_counts_driver_states() -> None:
+    b = bridge(command_timeout_s=0.003)
+    b.start()
+    b.on_state(state(1), 0.0)
+    assert b.on_command(cmd(1), 0.0) is not None
+    zeros = [b.on_state(state(k), 0.0)[1] for k in range(2, 7)]
+    assert [z is not None for z in zeros] == [False, False, False, True, True]  # > 3 ms
+    assert zeros[-1] is not None and zeros[-1].zero_because == "no loop command"
+    assert b.watchdog.trips == 1
+    assert b.on_command(cmd(6), 0.0) is not None  # the loop again: the command passes
+    assert b.on_state(state(7), 0.0)[1] is None
+
+
+def test_a_stale_state_is_not_rendered() -> None:
+    b = bridge()
+    b.start()
+    b.on_state(state(1), 0.0)
+    assert b.on_wakeup(0.005) is None  # within state.timeout_s (10 ms)
+    zero = b.on_wakeup(0.011)
+    assert zero is not None and zero.zero_because == "no driver state" and b.state_trips == 1
+    assert b.on_command(cmd(1), 0.012) is None  # the command for the stale state: dropped
+    assert b.on_wakeup(0.015) is None and b.on_wakeup(0.022) is not None  # zero again
+    b.on_state(state(2), 0.03)
+    assert not b.state_stale and b.on_command(cmd(2), 0.03) is not None
+
+
+def test_the_deadman_gates_every_command() -> None:
+    b = bridge(deadman="bool", deadman_topic="/pedal")
+    b.start()
+    _, zero = b.on_state(state(1), 0.0)
+    assert zero is not None and zero.zero_because == "dead-man released"  # never seen: released
+    assert b.on_command(cmd(1), 0.0) is None and b.gated == 1
+    assert b.on_deadman(True) is None
+    b.on_state(state(2), 0.0)
+    assert b.on_command(cmd(2), 0.0) is not None
+    zero = b.on_deadman(False)
+    assert zero is not None and zero.values == (0.0, 0.0, 0.0) and b.deadman_releases == 1
+
+
+def test_nan_and_the_wrong_length_are_refused_and_send_zero_stale_ones_are_dropped() -> None:
+    b = bridge()
+    b.start()
+    b.on_state(state(1), 0.0)
+    b.on_state(state(2), 0.0)
+    for bad in (cmd(2, math.nan, 0.0, 0.0), cmd(2, math.inf, 0.0, 0.0), cmd(2, 1.0, 2.0)):
+        send = b.on_command(bad, 0.0)
+        assert send is not None and send.values == (0.0, 0.0, 0.0)
+    assert b.refused == 3
+    assert b.on_command(cmd(2), 0.0) is not None
+    assert b.on_command(cmd(1), 0.0) is None  # older than the newest answered
+    assert b.on_command(cmd(2), 0.0) is None  # answered already
+    assert b.on_command(cmd(3), 0.0) is None  # a sample not handed on
+    assert b.dropped == 3
+    b.on_state(state(3), 0.0)
+    assert b.on_command(cmd(None), 0.0) is not None  # unlabelled: the newest
+
+
+def test_a_state_whose_stamp_did_not_advance_is_not_a_new_state_and_the_stop_is_zero() -> None:
+    b = bridge()
+    b.start()
+    b.on_state(state(2), 0.0)
+    assert b.on_state(state(2), 0.0) == (None, None)
+    assert b.on_state(state(1), 0.0) == (None, None)
+    stop = b.stop()
+    assert stop.values == (0.0, 0.0, 0.0) and stop.zero_because == "stopping"
+    assert b.on_state(state(3), 0.0) == (None, None) and b.on_command(cmd(2), 0.0) is None
+
+
+def test_late_commands_are_counted_per_state() -> None:
+    b = bridge()
+    b.start()
+    b.on_state(state(1), 0.0)
+    b.on_command(cmd(1), 0.0)
+    b.on_state(state(2), 0.001)
+    b.on_state(state(3), 0.002)  # state 2 got no command before state 3
+    assert b.on_command(cmd(2), 0.0025) is not None  # late, still newer than the last answered
+    assert (b.on_time, b.late) == (1, 1)
+    assert b.counts()["on_time_pct"] == pytest.approx(50.0)
+
+
+def test_states_whose_stamps_do_not_advance_are_said_once_and_counted() -> None:
+    said: list[str] = []
+    driver = DriverSettings.of({"state.topic": "s", "command.topic": "c"})
+    safety = SafetySettings(command_limits=[5.0]).check()
+    b = BridgeLoop(driver, safety, model(), FD, 1000.0, said.append)
+    b.start()
+    b.on_state(state(0), 0.0)  # a driver that leaves its stamps at zero
+    for _ in range(3):
+        assert b.on_state(state(0), 0.0) == (None, None)
+    assert b.counts()["states_not_advancing"] == 3
+    assert len([s for s in said if "do not advance" in s]) == 1
