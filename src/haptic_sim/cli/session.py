@@ -166,7 +166,7 @@ def main(argv: list[str] | None = None) -> int:
         "--stiffness",
         type=float,
         metavar="N_PER_M",
-        help="override the wall stiffness (and adapt the semi-random hand's push)",
+        help="override the wall stiffness (the hand pushes to the same depth)",
     )
     p.add_argument("--duration", type=float, metavar="S", help="override the length in seconds")
     p.add_argument("--seed", type=int, help="override the seed")
