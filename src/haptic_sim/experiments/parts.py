@@ -28,7 +28,7 @@ from haptic_sim.experiments import (
     plan,
     results,
     slave_model,
-    spread,
+    spread_report,
     stability_map,
     sweeps,
     sweeps_report,
@@ -260,21 +260,28 @@ SWEEPS: Experiment[sweeps.SweepStudy] = Experiment(
     heading="Table 7.1's cells that stay off, against the parameter responsible (batch)",
     intro="Controllers of Table 7.1 in the chapter-7 session (40 s, the hand's seed 0, "
     "as chapter 7's default), with one parameter swept from the chapter-7 value: "
-    "the hand's grip damping at 2400 N/m, the actuator's force limit at 80 N/m, the observer "
-    "gain at every wall (DOB), the force sensor's bandwidth at 1600 and 2400 N/m (CL): each "
-    "cell that stays off has its sweep. Then the whole table for other seeds of the hand.",
+    "the hand's grip damping at 2400 N/m (and, for OL with a loose grip, the friction), the "
+    "hand's depth at 80 N/m, the observer gain and "
+    "the plant's low-speed friction at every wall (DOB), the force sensor's bandwidth at 1600 "
+    "and 2400 N/m (CL): each cell that stays off has its sweep. Then the whole table for three "
+    "seeds of the hand and their median.",
     body=lambda r, _base: [
-        sweeps.sweep_table(r, sweeps.GRIP),
+        sweeps_report.sweep_table(r, sweeps.GRIP),
         sweeps_report.grip_text(r),
-        sweeps.sweep_table(r, sweeps.FORCE_LIMIT),
-        sweeps_report.limit_text(r),
-        sweeps.sweep_table(r, sweeps.OBSERVER),
+        sweeps_report.sweep_table(r, sweeps.VIBRATING),
+        sweeps_report.vibrating_text(r),
+        sweeps_report.sweep_table(r, sweeps.DEPTH),
+        sweeps_report.depth_text(r),
+        sweeps_report.sweep_table(r, sweeps.OBSERVER),
         sweeps_report.observer_text(r),
-        sweeps.sweep_table(r, sweeps.SENSOR),
+        sweeps_report.sweep_table(r, sweeps.FRICTION),
+        sweeps_report.friction_text(r),
+        sweeps_report.sweep_table(r, sweeps.SENSOR),
         sweeps_report.sensor_text(r),
-        spread.spread_table(r.seeds),
+        spread_report.spread_table(r.seeds),
     ],
     figures=(),
+    checks=sweeps_report.checks,
     differences=sweeps_report.differences,
 )
 PHANTOM: Experiment[phantom.PhantomResult] = Experiment(

@@ -54,7 +54,7 @@ def _every_part() -> dict[str, object]:
         _run("ch6", "OL", 0.0, 2800.0, perturbation_growth_per_s=None, perturbation_vibrates=True),
     ]
     kick = [
-        dob_mechanism.KickPoint(w, 7.0, 0.24, 1e-5 * w / 4000.0, 30.0) for w in dob_mechanism.WALLS
+        dob_mechanism.KickPoint(w, 7.0, 0.24, 1e-4 * w / 4000.0, 30.0) for w in dob_mechanism.WALLS
     ]
     fits = [
         SlideFit("least_squares", "slide", 0.42, 1.25, 0.245, 1e-3, 0.02, 4e-3, 900, 0.01),
