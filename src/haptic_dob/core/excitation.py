@@ -1,22 +1,15 @@
 """A known force the virtual environment adds: identification's input.
 
-The thesis identified its slide (ch. 4.2) from the response to a 2.4 N force step under an
-80 N/m virtual spring and verified the model (ch. 4.3) with 1.6 N and 3.2 N steps and a 0.6 N,
-2 Hz sine. The environment node renders that input: its force is the wall's plus the excitation
-at ``t``, the sample's time (its stamp), so a lockstep run is deterministic and a batch run gives
-the same samples. The joint state's effort then carries the input, which is all
-``haptic-identify`` needs.
-
-``along``: ``normal`` adds ``force_n(t)`` along the wall normal (the slide's one axis);
-``axes`` adds a signal of its own along each of the base frame's x, y and z (a Cartesian device's
-session, every axis identified from one record): the same kind, each axis a third of
-``period_s`` later than the one before, so the three are not alike. ``chirp``: a logarithmic sweep
-from ``low_hz`` to ``high_hz`` over ``period_s``, repeated; ``multisine``: every multiple of
-``1 / period_s`` in [low_hz, high_hz] at equal amplitude, Schroeder's phases (a low crest
-factor), scaled so that its peak is ``amplitude_n``; every kind stays within +-``amplitude_n``
-per axis. ``hold_n_per_m`` > 0 adds an isotropic spring toward ``hold_at`` (the workspace's
-centre), whose force is in the command like the rest: it keeps a device that nothing else holds
-in its workspace while the excitation moves it.
+The environment's force is the wall's plus the excitation at ``t``, the sample's time (its
+stamp), so a lockstep run is deterministic and a batch run gives the same samples; the joint
+state's effort then carries the input that ``haptic-identify`` fits. ``along``: ``normal`` adds
+``force_n(t)`` along the wall normal; ``axes`` adds a signal of the same kind along each of the
+base frame's x, y and z, each axis a third of ``period_s`` later than the one before. ``chirp``:
+a logarithmic sweep from ``low_hz`` to ``high_hz`` over ``period_s``, repeated; ``multisine``:
+every multiple of ``1 / period_s`` in [low_hz, high_hz] at equal amplitude with Schroeder's
+phases, scaled so that its peak is ``amplitude_n``; every kind stays within +-``amplitude_n``
+per axis. ``hold_n_per_m`` > 0 adds an isotropic spring toward ``hold_at``, its force in the
+command like the rest. Why these inputs: docs/design/identification.md.
 """
 
 from __future__ import annotations

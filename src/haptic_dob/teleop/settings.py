@@ -3,17 +3,13 @@ and the channel between master and slave (``ChannelSettings``).
 
 Frames and units: the slave's base frame carries the channel's quantities. The master's
 displacement ``d_m`` from its start point maps to the slave's as ``position_scale * R d_m``; a
-force ``F`` of the slave's side reaches the master as ``force_scale * R^T F``. ``R`` is a
+force ``F`` of the slave's side reaches the master as ``force_scale * R^T F``; ``R`` is a
 rotation (row-major 3x3 ``rotation``); for a 1-DOF master (the slide) only its axis's column
-matters and the rendered force is taken along the axis.
-
-Architectures:
-
-- ``position_force``: the slave tracks the master's (delayed) position; the master renders the
-  slave's contact force, from the slave's observer (``force_source: estimate``, no sensor) or
-  from a wrist force sensor (``sensor``);
-- ``position_position``: both track each other's delayed position; the master renders a coupling
-  spring-damper ``K (x_s - x_m) + B (v_s - v_m)`` (slave units) to the slave's delayed position.
+matters and the rendered force is taken along the axis. Architectures: ``position_force``, the
+slave tracks the master's (delayed) position and the master renders the slave's contact force,
+from the slave's observer (``force_source: estimate``) or a wrist sensor (``sensor``);
+``position_position``, both track each other's delayed position and the master renders a
+coupling spring-damper ``K (x_s - x_m) + B (v_s - v_m)`` (slave units).
 """
 
 from __future__ import annotations

@@ -163,6 +163,7 @@ class SessionSummary:
     bandwidth_hz: float | None
     impedance_error_pct: float | None
     coherence_in_band: float | None
+    band_below_first_bin: bool = False  # the band ends below the first bin (a floor, not a value)
 
 
 @dataclass
@@ -228,6 +229,7 @@ class SessionResult:
             bandwidth_hz=None if tr is None else tr.bandwidth_hz,
             impedance_error_pct=None if tr is None else tr.impedance_error_pct,
             coherence_in_band=None if tr is None else tr.mean_coherence_in_band,
+            band_below_first_bin=False if tr is None else tr.band_below_first_bin,
         )
 
     def save(self, path: str | Path) -> None:

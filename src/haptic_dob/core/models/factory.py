@@ -6,7 +6,8 @@
 - ``phantom``: ``phantom.params`` (``appendix_b`` | ``cavusoglu``), ``phantom.gravity``,
   ``phantom.viscous_n_m_s_per_rad`` (``PhantomSettings``).
 - ``urdf``: ``robot_description`` (URDF text, the ROS convention) or ``urdf_path``, ``tip_frame``,
-  ``joint_names``, plus ``urdf.gravity``, ``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``.
+  ``joint_names``, plus ``urdf.gravity``, ``urdf.viscous_n_m_s_per_rad``, ``urdf.coulomb_n_m``,
+  ``urdf.coulomb_speed_rad_per_s`` and ``urdf.armature_kg_m2``.
 
 All of them are structural, so read-only.
 """
