@@ -1,20 +1,17 @@
 """In-process hand-over of loop values between the nodes of one process (ROS-free).
 
-The model is rclcpp's intra-process manager: nodes that share a process pass each other the
-message itself, and the middleware still serves every reader elsewhere. Here a publish
+After rclcpp's intra-process manager, a publish
 
 1. calls every subscriber of the topic in this process at once, depth first, with the immutable
-   value (no serialization, no executor): the device's sample reaches the environment, its wall
-   force the controller, the controller's command the device, all inside the device's publish;
+   value (no serialization, no executor);
 2. queues the middleware send for readers in other processes (only while some are matched) and
-   sends the queue when the outermost publish returns, so nothing goes out on DDS before the
+   sends the queue when the outermost publish returns: nothing goes out on DDS before the
    command has reached the device.
 
-``begin()``/``end()`` (or ``batch()``) make several publishes one outermost publish (a device's
-whole sample). A publisher
-that is published to again from inside its own delivery (a cycle in the graph) is deferred, as is
-work given to ``call_soon`` while a publish is under way: ``run_soon`` runs it, from the spin
-loop, once the publish has returned. One ``Bus`` per ROS context (``bus_for``).
+``begin()``/``end()`` (or ``batch()``) make several publishes one outermost publish. A publisher
+published to from inside its own delivery (a cycle in the graph) is deferred, as is work given
+to ``call_soon`` during a publish: ``run_soon`` runs it from the spin loop once the publish has
+returned. One ``Bus`` per ROS context (``bus_for``). Why: docs/design/timing.md.
 """
 
 from __future__ import annotations

@@ -9,8 +9,10 @@ protocol). All quantities act along the device's axis (1-D) and are SI.
 Behaviours (``HandParams.behaviour``):
 
 - ``semi_random``: ``x_r = ramp(t) * offset + amplitude * n(t)``, ``n`` unit-variance Gaussian
-  noise band-limited to [band_low_hz, band_high_hz] (4th-order Butterworth band-pass, zero mean),
-  the thesis's "semi-random" transparency excitation (40 s per run).
+  noise band-limited to [band_low_hz, band_high_hz] (4th-order Butterworth band-pass, zero mean)
+  and rolled off above ``rolloff_hz`` (2nd-order Butterworth low-pass; 0: none), the thesis's
+  "semi-random" transparency excitation (40 s per run). The reference is a depth, the same at
+  every wall (``depth_reference``): the push rises with the wall.
 - ``push_hold``: ``x_r = ramp(t) * offset`` held, plus a rectangular force pulse of
   ``perturbation_n`` lasting ``perturbation_s`` at ``perturbation_at_s``: the vibration protocol.
 - ``none``: no hand (zero force; the device moves only under its actuator).
@@ -54,40 +56,79 @@ class HandParams:
 
     behaviour: str = field(
         default="semi_random",
-        metadata=param("what the simulated hand does", choices=BEHAVIOURS, read_only=True),
+        metadata=param(
+            description="what the simulated hand does", choices=BEHAVIOURS, read_only=True
+        ),
     )
     mass_kg: float = field(
-        default=0.1, metadata=param("hand mass moving with the handle", "kg", 0.0, 10.0)
+        default=0.1,
+        metadata=param(
+            description="hand mass moving with the handle", unit="kg", bounds=(0.0, 10.0)
+        ),
     )
     stiffness_n_per_m: float = field(
-        default=300.0, metadata=param("grip stiffness toward the reference", "N/m", 0.0, 1e5)
+        default=300.0,
+        metadata=param(
+            description="grip stiffness toward the reference", unit="N/m", bounds=(0.0, 1e5)
+        ),
     )
     damping_n_s_per_m: float = field(
-        default=10.0, metadata=param("grip damping toward the reference", "N s/m", 0.0, 1e3)
+        default=10.0,
+        metadata=param(
+            description="grip damping toward the reference", unit="N s/m", bounds=(0.0, 1e3)
+        ),
     )
     offset_m: float = field(
-        default=0.0091667, metadata=param("reference push past the start position", "m", -1.0, 1.0)
+        default=0.0075,
+        metadata=param(
+            description="reference push past the start position", unit="m", bounds=(-1.0, 1.0)
+        ),
     )
     amplitude_m: float = field(
-        default=0.0011458, metadata=param("std of the semi-random reference motion", "m", 0.0, 1.0)
+        default=0.0013554,
+        metadata=param(
+            description="std of the semi-random reference motion", unit="m", bounds=(0.0, 1.0)
+        ),
     )
     band_low_hz: float = field(
-        default=0.05, metadata=param("low edge of the semi-random motion band", "Hz", 1e-3, 1e3)
+        default=0.05,
+        metadata=param(
+            description="low edge of the semi-random motion band", unit="Hz", bounds=(1e-3, 1e3)
+        ),
     )
     band_high_hz: float = field(
-        default=10.0, metadata=param("high edge of the semi-random motion band", "Hz", 1e-3, 1e3)
+        default=10.0,
+        metadata=param(
+            description="high edge of the semi-random motion band", unit="Hz", bounds=(1e-3, 1e3)
+        ),
+    )
+    rolloff_hz: float = field(
+        default=5.0,
+        metadata=param(
+            description="corner of the motion's 2nd-order roll-off; 0 = none",
+            unit="Hz",
+            bounds=(0.0, 1e3),
+        ),
     )
     ramp_s: float = field(
-        default=1.0, metadata=param("smooth ramp-in time of the reference", "s", 0.0, 1e3)
+        default=1.0,
+        metadata=param(
+            description="smooth ramp-in time of the reference", unit="s", bounds=(0.0, 1e3)
+        ),
     )
     perturbation_n: float = field(
-        default=0.0, metadata=param("push_hold: force pulse amplitude", "N", -100.0, 100.0)
+        default=0.0,
+        metadata=param(
+            description="push_hold: force pulse amplitude", unit="N", bounds=(-100.0, 100.0)
+        ),
     )
     perturbation_at_s: float = field(
-        default=1.5, metadata=param("push_hold: pulse start time", "s", 0.0, 1e6)
+        default=1.5,
+        metadata=param(description="push_hold: pulse start time", unit="s", bounds=(0.0, 1e6)),
     )
     perturbation_s: float = field(
-        default=0.005, metadata=param("push_hold: pulse duration", "s", 0.0, 10.0)
+        default=0.005,
+        metadata=param(description="push_hold: pulse duration", unit="s", bounds=(0.0, 10.0)),
     )
 
     def __post_init__(self) -> None:
@@ -106,6 +147,7 @@ class HandParams:
         )
         if lo >= hi:
             raise ValueError(f"band_low_hz ({lo}) must be below band_high_hz ({hi})")
+        nonnegative("rolloff_hz", self.rolloff_hz)
         nonnegative("ramp_s", self.ramp_s)
         finite_scalar("perturbation_n", self.perturbation_n)
         nonnegative("perturbation_at_s", self.perturbation_at_s)
@@ -117,40 +159,92 @@ class HandParams:
         return self.behaviour != "none"
 
 
-#: default session push and force swing of the semi-random hand (N)
-DEFAULT_PUSH_N = 2.0
-DEFAULT_FORCE_STD_N = 0.25
+@dataclass(frozen=True)
+class DepthReference:
+    """A depth-regulating hand's reference (m) and what it gives at the walls it was set for."""
+
+    offset_m: float
+    amplitude_m: float
+    push_n: dict[float, float]  # wall (N/m) -> mean push (N), static
+    swing_n: dict[float, float]  # wall -> the force's std (N), linear model
+    depth_std_ratio: dict[float, float]  # wall -> the position's std over its mean depth
 
 
-def reference_for_force(
-    wall_stiffness_n_per_m: float,
-    hand_stiffness_n_per_m: float,
-    push_force_n: float = DEFAULT_PUSH_N,
-    force_std_n: float = DEFAULT_FORCE_STD_N,
-) -> tuple[float, float]:
-    """Reference offset and amplitude (m) for a mean push and a quasi-static force swing (N).
+def _responses(
+    params: HandParams, wall: float, mass_kg: float, viscous: float, dt: float
+) -> tuple[float, float, float]:
+    """(static push per m of reference offset, force std and position std per m of reference
+    std) at one wall, for the linear model of hand, slide and an ideally rendered wall."""
+    from scipy import signal
 
-    A person regulates force, not position: against a stiffer wall they move less. With the grip
-    spring k_h in series with the wall K the static compliance is ``1/K + 1/k_h``; offset and
-    amplitude are the push and the swing times that compliance. (Dynamics add to the swing near
-    the hand-device resonance; the defaults keep contact over 99 % of a session at 80-2400 N/m.)
+    m, b = mass_kg + params.mass_kg, viscous + params.damping_n_s_per_m
+    kh, bh, mh = params.stiffness_n_per_m, params.damping_n_s_per_m, params.mass_kg
+    f = np.geomspace(params.band_low_hz * 1e-3, 0.5 / dt, 200_000)
+    _, h_ref = signal.sosfreqz(_band_filter(params, dt), worN=f, fs=1.0 / dt)
+    weight = np.abs(h_ref) ** 2
+    s = 2j * np.pi * f
+    x = (kh + bh * s) / (m * s * s + b * s + wall + kh)  # X / X_r
+    force = (kh + bh * s) * (1.0 - x) - mh * s * s * x  # F_h / X_r
+
+    def rms(h: np.ndarray) -> float:
+        return math.sqrt(float(np.trapezoid(np.abs(h) ** 2 * weight, f) / np.trapezoid(weight, f)))
+
+    return kh * wall / (wall + kh), rms(force), rms(x)
+
+
+def depth_reference(
+    params: HandParams,
+    walls: tuple[float, ...],
+    mass_kg: float,
+    viscous_n_s_per_m: float,
+    max_force_n: float,
+    sigmas: float = 3.0,
+    dt: float = 1e-4,
+) -> DepthReference:
+    """One reference (offset, amplitude in m) for every wall: a person pushing to a depth.
+
+    The hand acts through its grip on the slide (``mass_kg``, ``viscous_n_s_per_m``) and an
+    ideally rendered wall (no friction, no delay), with the reference's spectrum of ``params``
+    (band, roll-off; period ``dt`` s). At the stiffest wall the push is half the actuator's
+    ``max_force_n`` and the force stays within [0, max_force_n] over ``sigmas`` standard
+    deviations; at every wall the slide's position swing stays inside the wall over ``sigmas``
+    (its std at most its mean depth over ``sigmas``). The amplitude is the smaller of the two.
     """
-    k_h = positive("hand_stiffness_n_per_m", hand_stiffness_n_per_m)
-    k_w = nonnegative("wall_stiffness_n_per_m", wall_stiffness_n_per_m)
-    push = finite_scalar("push_force_n", push_force_n)
-    std = nonnegative("force_std_n", force_std_n)
-    compliance = 1.0 / k_h + (1.0 / k_w if k_w > 0.0 else 0.0)
-    return push * compliance, std * compliance
+    ks = [positive("wall", w) for w in walls]
+    if not ks:
+        raise ValueError("walls must not be empty")
+    positive("mass_kg", mass_kg)
+    nonnegative("viscous_n_s_per_m", viscous_n_s_per_m)
+    limit, n = positive("max_force_n", max_force_n), positive("sigmas", sigmas)
+    resp = {k: _responses(params, k, mass_kg, viscous_n_s_per_m, dt) for k in ks}
+    top = max(ks)
+    offset = 0.5 * limit / resp[top][0]
+    by_force = 0.5 * limit / n / resp[top][1]
+    # mean depth X_off k_h / (K + k_h) against the position's std: both per m of reference
+    kh = params.stiffness_n_per_m
+    by_contact = min(offset * kh / (k + kh) / n / resp[k][2] for k in ks)
+    amp = min(by_force, by_contact)
+    return DepthReference(
+        offset,
+        amp,
+        {k: offset * resp[k][0] for k in ks},
+        {k: amp * resp[k][1] for k in ks},
+        {k: amp * resp[k][2] / (offset * kh / (k + kh)) for k in ks},
+    )
 
 
 def _band_filter(params: HandParams, dt: float) -> np.ndarray:
-    """The reference's band-pass (4th-order Butterworth) at sample period ``dt`` (s)."""
+    """The reference's band-pass (4th-order Butterworth) at sample period ``dt`` (s), followed by
+    the 2nd-order Butterworth low-pass at ``rolloff_hz`` when it is set."""
     from scipy import signal  # here: a device process without a band (push and hold) starts faster
 
     nyq = 0.5 / dt
     sos: np.ndarray = signal.butter(
         4, [params.band_low_hz / nyq, params.band_high_hz / nyq], btype="bandpass", output="sos"
     )
+    if params.rolloff_hz > 0.0:
+        low = signal.butter(2, params.rolloff_hz / nyq, output="sos")
+        sos = np.concatenate([sos, low])
     return sos
 
 

@@ -20,13 +20,18 @@ class ForceSensorParams:
     """Force sensor: white noise (N, std), first-order bandwidth (Hz), constant bias (N)."""
 
     noise_std_n: float = field(
-        default=NANO17_NOISE_STD_N, metadata=param("force-sensor white noise (std)", "N", 0.0, 10.0)
+        default=NANO17_NOISE_STD_N,
+        metadata=param(description="force-sensor white noise (std)", unit="N", bounds=(0.0, 10.0)),
     )
     bandwidth_hz: float = field(
         default=NANO17_BANDWIDTH_HZ,
-        metadata=param("force-sensor first-order bandwidth", "Hz", 1.0, 1e5),
+        metadata=param(
+            description="force-sensor first-order bandwidth", unit="Hz", bounds=(1.0, 1e5)
+        ),
     )
-    bias_n: float = field(default=0.0, metadata=param("force-sensor bias", "N", -10.0, 10.0))
+    bias_n: float = field(
+        default=0.0, metadata=param(description="force-sensor bias", unit="N", bounds=(-10.0, 10.0))
+    )
 
     def __post_init__(self) -> None:
         nonnegative("noise_std_n", self.noise_std_n)

@@ -1,10 +1,11 @@
 """Bags of a driver's ``joint_states`` as ``ros2 bag record`` would hold them (rosbags, MCAP and
-sqlite3), from a 1-DOF record or from several joints' arrays."""
+sqlite3), from a 1-DOF record, an arm's record, or several joints' arrays."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from rosbags.rosbag2 import StoragePlugin, Writer
@@ -39,17 +40,32 @@ def write_bag(
     return path
 
 
+def write_arm_bag(
+    path: Path,
+    record: Any,
+    effort: bool = True,
+    names: Sequence[str] | None = None,
+    storage: str = "mcap",
+) -> Path:
+    """An arm's record (``stamps_ns``, ``position``, ``effort``, ``names``) as a driver's
+    ``/joint_states`` bag: every joint in one message, no velocity (a driver that sends none),
+    the joints named ``names`` instead when given."""
+    given = np.asarray(record.effort, np.float64) if effort else None
+    names = list(names or record.names)
+    return write_joint_states(path, record.stamps_ns, names, record.position, given, storage)
+
+
 def write_joint_states(
     path: Path,
     stamps_ns: np.ndarray,
     names: Sequence[str],
     position: np.ndarray,
-    effort: np.ndarray,
+    effort: np.ndarray | None,
     storage: str = "mcap",
     topic: str = "/joint_states",
 ) -> Path:
-    """A bag of ``topic`` holding position and effort of ``names`` (arrays (N, n)) and no
-    velocity, as a position-only driver's ``joint_states`` with the effort it applied."""
+    """A bag of ``topic`` holding position and effort (None: none) of ``names`` (arrays (N, n))
+    and no velocity, as a position-only driver's ``joint_states``."""
     plugin = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}[storage]
     writer = Writer(path, version=9, storage_plugin=plugin)
     writer.open()
@@ -57,10 +73,11 @@ def write_joint_states(
         conn = writer.add_connection(topic, "sensor_msgs/msg/JointState", typestore=wire.TYPESTORE)
         msg = wire.joint_state(list(names), "base_link")
         msg.velocity = np.array([], np.float64)
-        for st, q, u in zip(stamps_ns.tolist(), position, effort, strict=True):
+        efforts = effort if effort is not None else [None] * len(stamps_ns)
+        for st, q, u in zip(stamps_ns.tolist(), position, efforts, strict=True):
             msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(st), 10**9)
             msg.position = np.asarray(q, np.float64)
-            msg.effort = np.asarray(u, np.float64)
+            msg.effort = np.array([], np.float64) if u is None else np.asarray(u, np.float64)
             writer.write(conn, int(st) + 1, wire.encode(msg))
     finally:
         writer.close()

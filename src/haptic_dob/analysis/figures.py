@@ -14,12 +14,7 @@ import numpy as np
 
 from haptic_dob.analysis.energy import EnergyResult, passivity_observer
 from haptic_dob.analysis.oscillation import Oscillation, OscillationSettings, oscillation
-from haptic_dob.analysis.transparency import (
-    DEFAULT_FMAX_HZ,
-    DEFAULT_SEGMENT_S,
-    TransparencyResult,
-    transparency,
-)
+from haptic_dob.analysis.transparency import DEFAULT_FMAX_HZ, TransparencyResult, transparency
 
 
 @dataclass
@@ -42,19 +37,20 @@ def analyze_arrays(
     damping_n_s_per_m: float = 0.0,
     penetration: np.ndarray | None = None,
     fmax_hz: float = DEFAULT_FMAX_HZ,
-    segment_s: float = DEFAULT_SEGMENT_S,
+    segment_s: float | None = None,
     oscillation_settings: OscillationSettings | None = None,
 ) -> Figures:
     """Transparency, energy, contact and vibration of motion x (m), hand force (N), v (m/s).
 
     ``penetration`` (m, > 0 in the wall) gives the contact share; the record should already
-    leave out what is to be left out.
+    leave out what is to be left out. ``segment_s`` is the transparency's Welch segment (None: the
+    record's default); the vibration detector keeps its own.
     """
     dt = 1.0 / fs_hz
     energy = passivity_observer(force, velocity, dt)
     touching = None if penetration is None else penetration > 0.0
     contact = None if touching is None else float(np.mean(touching) * 100.0)
-    osc = oscillation(x, fs_hz, touching, oscillation_settings, segment_s)
+    osc = oscillation(x, fs_hz, touching, oscillation_settings)  # its own 2 s Welch segments
     tr, problem = None, None
     if stiffness_n_per_m is None:
         problem = "no wall stiffness recorded (pass --stiffness)"

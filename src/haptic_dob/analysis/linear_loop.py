@@ -1,24 +1,16 @@
 """The slide's loop in contact as a linear discrete-time system: stability without simulation.
 
-Plant ``m x'' + b x' = F_a + F_h`` discretised exactly with a zero-order hold at period T, the
-applied force ``F_a`` the command ``u`` itself or, with an amplifier lag ``tau_a``, its first-order
-lag (``tau_a F_a' = u - F_a``: the observer knows only ``u``); the hand
-``F_h = F_push - k_h x`` (a push through a grip spring ``k_h``, as in the onset protocol; the
-constant push drops out of the perturbation dynamics); the wall ``F_w = -K x`` on the encoder
-sample; the observer exactly as ``DisturbanceObserver`` updates (pole-matched implicit update,
-backward-difference velocity, the effort applied over the last period) with the plant's m and b,
-so it estimates the hand force; CL with an ideal sensor reading ``F_h`` at the sample. The state
-is ``[x, v, (F_a,) x_prev, v_prev_sample, z_prev, u_prev]``; the loop is stable when every
-eigenvalue of the one-period map lies inside the unit circle.
+Plant ``m x'' + b x' = F_a + F_h``, discretised exactly with a zero-order hold at period T;
+``F_a`` is the command ``u``, or with an amplifier lag ``tau_a`` its lag ``tau_a F_a' = u - F_a``;
+the hand ``F_h = F_push - k_h x`` (the constant push drops out); the wall ``F_w = -K x`` on the
+encoder sample. DOB: the observer as ``DisturbanceObserver`` updates, with the plant's m and b;
+CL: an ideal sensor reading ``F_h`` at the sample. The state is
+``[x, v, (F_a,) x_prev, v_prev_sample, z_prev, u_prev]``; the loop is stable when every
+eigenvalue of the one-period map (``loop_map``) lies inside the unit circle.
 
-It explains what the thesis could not: the discrete observer answers sample k with the effort
-applied over [k-1, k) and a backward-difference velocity, so its estimate carries a piece of the
-command's own change, and with force feedback ``Kf`` that piece feeds the command back. The DOB
-loop is therefore *less* stable than CL with an ideal sensor (whose onset is the bound
-``2 b / (T (1 + Kf))``), increasingly so for a faster observer. The piece is about
-``-(c T / 2 m) u_k`` in the estimate of sample k+1, so the loop has a real mode near
-``-Kf c T / (2 m)``: the command alternating its sign every period. ``chatter_gain`` is the
-observer gain at which that mode leaves the unit circle (about ``2 m / (Kf T)``; a lag lowers it).
+The DOB loop has a real mode near ``-Kf c T / (2 m)``, the command alternating its sign every
+period; ``chatter_gain`` is the observer gain at which it leaves the unit circle (about
+``2 m / (Kf T)``; a lag lowers it). Why: docs/design/stability.md.
 """
 
 from __future__ import annotations

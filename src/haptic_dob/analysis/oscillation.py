@@ -1,28 +1,17 @@
 """Sustained oscillation in contact with the wall (vibration), from the motion record.
 
-A virtual wall that is too stiff for the loop does not just feel springy: the handle vibrates
-against it at the contact mode (on the slide 11-16 Hz) with an envelope that holds or grows. The
-deliberate hand motion of a transparency session lies below ``band[0]`` (the thesis's 10 Hz). So:
+1. The motion is band-passed to ``band_hz`` (4th-order Butterworth, zero phase); its amplitude
+   is ``sqrt(2)`` times the RMS (m).
+2. The frequency is the peak of its Welch spectrum (2 s Hann segments); the peak fraction is the
+   share of the band's power within +-1 Hz of the peak and of its 2nd and 3rd harmonics.
+3. The growth rate is the slope of ln(envelope) (``haptic_dob.analysis.envelope_growth``, 1/s).
+4. A window vibrates when it is in contact at least ``min_contact`` of the time, the amplitude
+   reaches ``threshold_m``, the peak fraction ``min_peak_fraction`` and the growth rate
+   ``min_growth_per_s``.
 
-1. the motion is band-passed to ``band`` (4th-order Butterworth, zero phase) and its amplitude is
-   ``sqrt(2)`` times the RMS (the amplitude of an equivalent sinusoid, m);
-2. the frequency is the peak of its Welch spectrum (2 s Hann segments); the *peak fraction* is
-   the share of the band's power within +-1 Hz of that peak and of its 2nd and 3rd harmonics
-   (a limit cycle or a growing oscillation puts nearly all power there, hand motion leaking
-   past 10 Hz about half);
-3. the growth rate is the slope of ln(envelope) (``haptic_dob.analysis.envelope_growth``);
-4. a window *vibrates* when it is in contact at least ``min_contact`` of the time, the
-   amplitude reaches ``threshold_m``, the peak fraction reaches ``min_peak_fraction`` and the
-   envelope does not decay faster than ``min_growth_per_s``.
-
-A record longer than two ``window_s`` is judged window by window (a burst of vibration in an
-hour is not averaged away, and memory stays bounded); the segment vibrates if any window does,
-reports the largest-amplitude vibrating window (else the largest-amplitude window) and how long
-its vibrating windows last.
-
-Calibrated on the simulated slide: semi-random sessions (OL/CL/DOB, 800-3000 N/m) give peak
-fractions 0.52-0.59 and growth ~0; the push-and-hold protocol above its onset gives 0.75-1.0
-and growth > 0. It is a heuristic: the figures are reported so a reader can judge.
+A record longer than two ``window_s`` is judged window by window: it vibrates if any window does,
+and reports the largest-amplitude vibrating window (else the largest) and how long its vibrating
+windows last. A heuristic; why these steps and its calibration: docs/design/stability.md.
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ import numpy as np
 
 from haptic_dob.analysis.figures import analyze_arrays
 from haptic_dob.analysis.oscillation import OscillationSettings
-from haptic_dob.analysis.transparency import DEFAULT_FMAX_HZ, DEFAULT_SEGMENT_S
+from haptic_dob.analysis.transparency import DEFAULT_FMAX_HZ
 from haptic_dob.analysis.vibration import PerturbationResponse, perturbation_response
 from haptic_dob.bag.errors import BagError
 from haptic_dob.bag.reader import AXES, Selection, read_bag
@@ -38,14 +38,14 @@ class AnalysisSettings:
     fmax_hz: float = DEFAULT_FMAX_HZ
     settle_s: float = 2.0
     transient_s: float = 0.5
-    segment_s: float = DEFAULT_SEGMENT_S
+    segment_s: float | None = None  # None: the transparency's default for the segment's length
     stiffness_n_per_m: float | None = None  # overrides the recorded wall stiffness
     oscillation: OscillationSettings = field(default_factory=OscillationSettings)
 
     def __post_init__(self) -> None:
         for name in ("fmax_hz", "segment_s"):
             v = getattr(self, name)
-            if not (v > 0.0 and math.isfinite(v)):
+            if v is not None and not (v > 0.0 and math.isfinite(v)):
                 raise ValueError(f"{name} must be > 0, got {v:g}")
         for name in ("settle_s", "transient_s"):
             v = getattr(self, name)

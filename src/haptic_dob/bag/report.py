@@ -34,6 +34,7 @@ CSV_FIELDS = (
     "analysed_s",
     "bandwidth_hz",
     "band_limited_by_fmax",
+    "band_below_first_bin",
     "impedance_error_pct",
     "coherence_in_band",
     "in_contact_pct",
@@ -99,6 +100,8 @@ def _row(r: SegmentResult) -> str:
     bw = _fmt(d["bandwidth_hz"], ".2f", " Hz")
     if d["band_limited_by_fmax"]:
         bw = ">=" + bw
+    elif d["band_below_first_bin"]:
+        bw = "<" + bw
     return (
         f"{r.segment.index:>3}  {r.start_s:>7.2f}-{r.end_s:<7.2f}  {ctl:<12} "
         f"{_fmt(r.stiffness_n_per_m, '.0f'):>8}  {bw:>9}  "

@@ -73,6 +73,7 @@ class SegmentResult:
             "analysed_s": self.analysed_s,
             "bandwidth_hz": None if tr is None else tr.bandwidth_hz,
             "band_limited_by_fmax": None if tr is None else tr.band_limited_by_fmax,
+            "band_below_first_bin": None if tr is None else tr.band_below_first_bin,
             "impedance_error_pct": None if tr is None else _num(tr.impedance_error_pct),
             "coherence_in_band": None if tr is None else _num(tr.mean_coherence_in_band),
             "in_contact_pct": f.in_contact_pct,

@@ -1,27 +1,16 @@
 """Which parameters were active when: steady segments of a session from its parameter events.
 
 Sources, in bag (log) time order, for the nodes in the motion topic's namespace:
+``new_parameters`` give a value (the first value known of a parameter counts from the start of
+the bag); ``changed_parameters`` / ``deleted_parameters`` change it at that moment (a parameter
+first seen in a change is unknown before it). Only ``RELEVANT`` parameters split the session:
+the controller's mode, kf and force limit, the wall's stiffness, damping, position and normal,
+the observer's gain and output limit; the device's label it. A change takes effect:
 
-- ``new_parameters`` (the recorder's snapshot of every node, or a node declaring its parameters
-  while ``ros2 bag record`` ran) give a parameter's value; the first value known of a
-  parameter this way counts from the start of the bag (nothing was recorded about it before);
-- ``changed_parameters`` / ``deleted_parameters`` change them at that moment (a parameter first
-  seen in a change is unknown before it).
-
-Only the parameters that shape the rendering (``RELEVANT``) split the session: the controller's
-mode, kf and force limit, the wall's stiffness, damping, position and normal, the observer's
-gain and output limit. Where a change takes effect:
-
-- an event stamped on the samples' own timeline (within the motion's stamps) splits at that
-  stamp: this suite's loop nodes stamp their events with the first sample the change applies to,
-  so the split is exact however late the event reached the recorder (a reliable message lost in
-  transit is repaired at the writer's next heartbeat, seconds later on a loaded machine); a
-  device stamping its samples with the system clock gives the same with any node's events;
-- otherwise (a wall-clock stamp beside samples stamped from a run's start) at the first motion
-  sample logged at or after the event: both carry the bag's log time, one time base in any bag
-  (``ros2 bag record``: the receive time; this suite's recorder: the session's time, the
-  samples at their stamps and the event at the newest stamp received before it), within a few
-  samples of the change when the event was not delayed in transit.
+- at its event's stamp when that lies within the motion's stamps (this suite's loop nodes stamp
+  an event with the first sample the change applies to; so does any node's system clock beside
+  a device stamping its samples with it);
+- otherwise at the first motion sample logged at or after the event. Why: docs/design/recording.md.
 """
 
 from __future__ import annotations

@@ -9,11 +9,12 @@ Parameter groups, each a frozen dataclass read by ``build`` (``runtime.params``)
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 from haptic_dob.runtime.params import build, param
+from haptic_msgs_py.topics import EFFORT_COMMAND, JOINT_STATES
 
 PROFILES = ("ros2_control_effort", "cartesian_wrench", "suite")
 STATE_TYPES = ("joint_states", "pose")
@@ -41,96 +42,107 @@ class StateSettings:
     topic: str = field(
         default="",
         metadata=param(
-            "the driver's state topic (absolute, or relative to the bridge's namespace); not "
-            "the loop's own joint_states"
+            description=(
+                "the driver's state topic (absolute, or relative to the bridge's namespace)"
+            ),
+            details=("Not the loop's own joint_states."),
         ),
     )
     type: str = field(
         default="joint_states",
         metadata=param(
-            "sensor_msgs/JointState, or geometry_msgs/PoseStamped (a Cartesian model only: q is "
-            "the tip's position)",
+            description=("sensor_msgs/JointState, or geometry_msgs/PoseStamped (Cartesian models)"),
             choices=STATE_TYPES,
+            details=("A pose state suits a Cartesian model only: q is the tip's position."),
         ),
     )
     reliability: str = field(
         default="reliable",
         metadata=param(
-            "QoS reliability of the subscription: reliable matches reliable publishers only "
-            "(joint_state_broadcaster), best_effort matches both (SensorDataQoS drivers)",
+            description="QoS reliability of the subscription",
             choices=RELIABILITY,
+            details=(
+                "reliable matches reliable publishers only (joint_state_broadcaster), best_effort "
+                "matches both (SensorDataQoS drivers)."
+            ),
         ),
     )
-    depth: int = field(default=10, metadata=param("queue depth of the subscription", "", 1, 1000))
+    depth: int = field(
+        default=10, metadata=param(description="queue depth of the subscription", bounds=(1, 1000))
+    )
     stamp: str = field(
         default="driver",
         metadata=param(
-            "the stamp the loop's samples carry: the driver's header stamp, or the system clock "
-            "when the state arrives (receipt: for a driver whose stamps are zero or do not "
-            "advance)",
+            description=("the stamp the loop's samples carry: the driver's, or the receipt time"),
             choices=STAMP_SOURCES,
+            details=(
+                "driver: the state's header stamp. receipt: the system clock when the state "
+                "arrives, for a driver whose stamps are zero or do not advance."
+            ),
         ),
     )
     joints: list[str] | tuple[str, ...] = field(
         default_factory=lambda: [""],
         metadata=param(
-            "the driver's name of each model joint, in the model's joint order ([''] = the "
-            "model's names); other joints in the state (grippers, a gimbal) are ignored"
+            description="the driver's name of each model joint, in model order; [''] = the model's",
+            details=("Other joints in the state (grippers, a gimbal) are ignored."),
         ),
     )
     signs: list[float] | tuple[float, ...] = field(
         default_factory=lambda: [1.0],
         metadata=param(
-            "+1 or -1 per model joint (one value: every joint): model q = sign * scale * driver "
-            "q; efforts and commands alike",
-            "",
-            -1.0,
-            1.0,
+            description=(
+                "+1 or -1 per model joint (or one for all): model q = sign * scale * driver q"
+            ),
+            bounds=(-1.0, 1.0),
+            details="Efforts and commands alike.",
         ),
     )
     scale: float = field(
         default=1.0,
         metadata=param(
-            "the driver's position unit in m or rad (0.001 for mm); velocities alike",
-            "",
-            1e-9,
-            1e9,
+            description="the driver's position unit in m or rad (0.001 for mm); velocities alike",
+            bounds=(1e-9, 1e9),
         ),
     )
     velocity: str = field(
         default="auto",
         metadata=param(
-            "joint velocity handed on: the driver's (driver), the backward difference of the "
-            "positions low-passed at velocity_cutoff_hz (difference), or the driver's where its "
-            "state has one (auto)",
+            description=("joint velocity handed on: the driver's, a filtered difference, or auto"),
             choices=VELOCITY_SOURCES,
+            details=(
+                "driver: the driver's. difference: the backward difference of the positions, "
+                "low-passed at velocity_cutoff_hz. auto: the driver's where its state has one."
+            ),
         ),
     )
     velocity_cutoff_hz: float = field(
         default=100.0,
         metadata=param(
-            "cutoff of the first-order low-pass on the differenced velocity; 0 = unfiltered",
-            "Hz",
-            0.0,
-            1e5,
+            description=(
+                "cutoff of the first-order low-pass on the differenced velocity; 0 = unfiltered"
+            ),
+            unit="Hz",
+            bounds=(0.0, 1e5),
         ),
     )
     effort: str = field(
         default="",
         metadata=param(
-            "effort of [k-1, k) in the loop's joint_states: what the bridge commanded "
-            "(commanded) or what the driver reports (driver); '' = the profile's",
+            description=("effort of [k-1, k) in the loop's joint_states; '' = the profile's"),
             choices=("", *EFFORT_SOURCES),
+            details=("commanded: what the bridge commanded; driver: what the driver reports."),
         ),
     )
     timeout_s: float = field(
         default=0.01,
         metadata=param(
-            "watchdog: zero command when no driver state came for this long (wall clock); a "
-            "stale state is not rendered",
-            "s",
-            0.001,
-            1.0,
+            description=(
+                "watchdog: zero command when no driver state came for this long (wall clock)"
+            ),
+            unit="s",
+            bounds=(0.001, 1.0),
+            details="A stale state is not rendered.",
         ),
     )
 
@@ -141,47 +153,66 @@ class CommandSettings:
 
     topic: str = field(
         default="",
-        metadata=param("the driver's command topic (<controller>/commands, force_feedback ...)"),
+        metadata=param(
+            description="the driver's command topic (<controller>/commands, force_feedback ...)"
+        ),
     )
     type: str = field(
         default="",
         metadata=param(
-            "float64_multi_array (joint efforts), wrench_stamped, wrench or vector3 (a force in "
-            "the base frame); '' = the profile's",
+            description=("the command's type: joint efforts, or a force; '' = the profile's"),
             choices=("", *COMMAND_TYPES),
+            details=(
+                "float64_multi_array: joint efforts; wrench_stamped, wrench or vector3: a force in "
+                "the base frame."
+            ),
         ),
     )
     reliability: str = field(
         default="reliable",
         metadata=param(
-            "QoS reliability of the publisher: reliable serves both kinds of subscription "
-            "(forward_command_controller's is reliable)",
+            description="QoS reliability of the publisher",
             choices=RELIABILITY,
+            details=(
+                "reliable serves both kinds of subscription (forward_command_controller's is "
+                "reliable)."
+            ),
         ),
     )
-    depth: int = field(default=10, metadata=param("history depth of the publisher", "", 1, 1000))
+    depth: int = field(
+        default=10, metadata=param(description="history depth of the publisher", bounds=(1, 1000))
+    )
     joints: list[str] | tuple[str, ...] = field(
         default_factory=lambda: [""],
         metadata=param(
-            "float64_multi_array: the controller's joints parameter in its order (driver names; "
-            "a joint the model lacks gets 0); [''] = state.joints"
+            description=(
+                "float64_multi_array: the controller's joints, in order; [''] = state.joints"
+            ),
+            details=(
+                "The controller's joints parameter in its order (driver names); a joint the model "
+                "lacks gets 0."
+            ),
         ),
     )
     frame_id: str = field(
-        default="", metadata=param("wrench_stamped: the header's frame_id; '' = base_frame")
+        default="",
+        metadata=param(description="wrench_stamped: the header's frame_id; '' = base_frame"),
     )
     scale: float = field(
-        default=1.0, metadata=param("driver command units per N (or N m)", "", 1e-9, 1e9)
+        default=1.0,
+        metadata=param(description="driver command units per N (or N m)", bounds=(1e-9, 1e9)),
     )
     delay_samples: int = field(
         default=-1,
         metadata=param(
-            "driver cycles from a command's arrival to the cycle it acts in: 1 for ros2_control "
-            "(written at its next update), 0 for a driver applying it on arrival; -1 = the "
-            "profile's",
-            "",
-            -1,
-            4,
+            description=(
+                "driver cycles from a command's arrival to the cycle it acts in; -1 = profile's"
+            ),
+            bounds=(-1, 4),
+            details=(
+                "1 for ros2_control (written at its next update), 0 for a driver applying it on "
+                "arrival."
+            ),
         ),
     )
 
@@ -193,17 +224,16 @@ class FrameSettings:
     axes: list[int] | tuple[int, ...] = field(
         default_factory=lambda: [0, 1, 2],
         metadata=param(
-            "force command and pose state: the driver's axis (0 x, 1 y, 2 z) of each model base "
-            "axis",
-            "",
-            0,
-            2,
+            description="the driver's axis (0 x, 1 y, 2 z) of each model base axis",
+            bounds=(0, 2),
+            details="For the force command and the pose state.",
         ),
     )
     signs: list[float] | tuple[float, ...] = field(
         default_factory=lambda: [1.0, 1.0, 1.0],
         metadata=param(
-            "+1 or -1 per model base axis: driver[axes[i]] = signs[i] * model[i]", "", -1.0, 1.0
+            description="+1 or -1 per model base axis: driver[axes[i]] = signs[i] * model[i]",
+            bounds=(-1.0, 1.0),
         ),
     )
 
@@ -269,3 +299,23 @@ class DriverSettings:
             raise ValueError("state.signs and frame.signs take +1 or -1 only")
         if self.state.type == "pose" and self.effort == "driver":
             raise ValueError("a pose state carries no effort: state.effort must be commanded")
+
+    def check_apart(self, resolve: Callable[[str], str]) -> None:
+        """``ValueError`` when the driver's state or command topic is the loop's own
+        (``resolve``: a topic's name as the bridge's node resolves it)."""
+        ours = {resolve(t) for t in (JOINT_STATES, EFFORT_COMMAND)}
+        for topic in (self.state.topic, self.command.topic):
+            if resolve(topic) in ours:
+                raise ValueError(
+                    f"the driver's {topic} is the loop's own topic here: run the loop in a "
+                    "namespace of its own (-r __ns:=/haptic) and name the driver's topics "
+                    "absolutely (/fd/joint_states)"
+                )
+
+    def describe(self) -> str:
+        """One line: the profile, the state and the command topics with their types and QoS."""
+        c, s = self.command, self.state
+        return (
+            f"a {self.profile} driver: state {s.topic} ({s.type}, {s.reliability}), "
+            f"command {c.topic} ({c.type}, {c.reliability})"
+        )

@@ -1,20 +1,17 @@
 """The bridge's cycle, ROS-free: a driver state to the loop, the loop's command to the driver.
 
-``on_state`` turns driver state k into the loop's sample k (the suite's contract: q, q', the
-effort in force over [k-1, k), the tip's point and velocity from the model's kinematics, the
-driver's stamp); ``on_command`` turns the loop's command for it into the driver's command at
-once (``CommandMap``, ``CommandLimiter``). Everything else is what keeps the hand safe, and every
-way out of it is zero:
+``on_state`` turns driver state k into the loop's sample k (q, q', the effort in force over
+[k-1, k), the tip's point and velocity from the model's kinematics, the driver's stamp);
+``on_command`` turns the loop's command for it into the driver's at once (``CommandMap``,
+``CommandLimiter``). Every way out is zero:
 
-- until ``start`` (the loop is up) and after ``stop``, the driver gets zero on every state;
-- the command watchdog (``core.watchdog``, in driver states): no valid command for
-  ``safety.command_timeout_s`` sends zero on every state until one comes;
-- the state watchdog (wall clock, ``on_wakeup``): no state for ``state.timeout_s`` sends zero
-  (again every timeout), and no command for the last state is taken (a stale state is not
-  rendered);
-- the dead-man: released (or never seen) sends zero at once and on every state;
-- a command of the wrong length or with NaN/inf is refused and sends zero; one for a sample
-  older than the newest answered, or not handed on, is dropped; nothing non-finite is sent.
+- before ``start``, after ``stop``, and while the dead-man is released or never seen: zero on
+  every state;
+- no valid command for ``safety.command_timeout_s`` (in driver states): zero until one comes;
+- no state for ``state.timeout_s`` (wall clock, ``on_wakeup``): zero, again every timeout, and
+  no command for the last state is taken;
+- a command of the wrong length or with NaN/inf is refused (zero); one for a sample older than
+  the newest answered, or not handed on, is dropped; nothing non-finite is sent. docs/safety.md.
 """
 
 from __future__ import annotations

@@ -3,7 +3,8 @@
 ``SafetySettings`` (``safety.*``: the clamp, the rate limit, the command watchdog, the dead-man)
 and ``RunSettings`` (when the bridge starts and stops, what it writes) are frozen dataclasses
 read by ``build`` (``runtime.params``); ``bridge_specs`` is the whole table with the driver's
-groups (``driver_settings``). ``per_element`` spreads one value over every command element.
+``DriverProfile`` and groups (``driver_settings``). ``per_element`` spreads one value over every
+command element.
 """
 
 from __future__ import annotations
@@ -30,49 +31,52 @@ class SafetySettings:
     command_limits: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "force clamp per command element, N (Cartesian) or N / N m (joints), before "
-            "command.scale: one value for every element or one each. Required: [] refuses to "
-            "start",
-            "N",
-            0.0,
-            1e4,
+            description=("force clamp per command element, one value or one each; required"),
+            unit="N",
+            bounds=(0.0, 1e4),
+            details=(
+                "N (Cartesian) or N / N m (joints), before command.scale. [] refuses to start."
+            ),
         ),
     )
     rate_limit: list[float] | tuple[float, ...] = field(
         default_factory=lambda: [2000.0],
         metadata=param(
-            "largest change of each command element per second (one value or one each); 0 = "
-            "none. A stop to zero is never slowed",
-            "N/s",
-            0.0,
-            1e7,
+            description=(
+                "largest change of each command element per second, one or one each; 0 = none"
+            ),
+            unit="N/s",
+            bounds=(0.0, 1e7),
+            details="A stop to zero is never slowed.",
         ),
     )
     command_timeout_s: float = field(
         default=0.005,
         metadata=param(
-            "watchdog: zero command when the loop's command stopped for this long, counted in "
-            "driver states",
-            "s",
-            0.0005,
-            1.0,
+            description=("watchdog: zero command when the loop's command stopped for this long"),
+            unit="s",
+            bounds=(0.0005, 1.0),
+            details="Counted in driver states.",
         ),
     )
     deadman: str = field(
         default="none",
         metadata=param(
-            "dead-man input: none, a std_msgs/Bool topic or a sensor_msgs/Joy button; force "
-            "only while held (never seen = released)",
+            description=("dead-man input: none, a std_msgs/Bool topic or a sensor_msgs/Joy button"),
             choices=DEADMAN_TYPES,
+            details="Force only while held; never seen = released.",
         ),
     )
-    deadman_topic: str = field(default="", metadata=param("the dead-man's topic"))
+    deadman_topic: str = field(default="", metadata=param(description="the dead-man's topic"))
     deadman_button: int = field(
-        default=0, metadata=param("deadman joy: index of the button to hold", "", 0, 63)
+        default=0,
+        metadata=param(description="deadman joy: index of the button to hold", bounds=(0, 63)),
     )
     deadman_reliability: str = field(
         default="reliable",
-        metadata=param("QoS reliability of the dead-man subscription", choices=RELIABILITY),
+        metadata=param(
+            description="QoS reliability of the dead-man subscription", choices=RELIABILITY
+        ),
     )
 
     def limits_for(self, n: int) -> tuple[float, ...]:
@@ -102,63 +106,79 @@ class RunSettings:
     wait_for: list[str] | tuple[str, ...] = field(
         default_factory=lambda: ["environment_node", "observer_node", "controller_node"],
         metadata=param(
-            "loop nodes (in this namespace, or fully qualified) that must be up before the "
-            "driver's states go to the loop; until then the driver gets zero",
+            description=("loop nodes that must be up before the driver's states go to the loop"),
             read_only=True,
+            details=("In this namespace, or fully qualified. Until then the driver gets zero."),
         ),
     )
     start_delay_s: float = field(
         default=0.5,
         metadata=param(
-            "settle time between the wait_for nodes being up and the first state handed on",
-            "s",
-            0.0,
-            60.0,
+            description=(
+                "settle time between the wait_for nodes being up and the first state handed on"
+            ),
+            unit="s",
+            bounds=(0.0, 60.0),
             read_only=True,
         ),
     )
     duration_s: float = field(
         default=0.0,
         metadata=param(
-            "stop (zero command, exit) this long after the first state handed on; 0 = never",
-            "s",
-            0.0,
-            1e6,
+            description=(
+                "stop (zero command, exit) this long after the first state handed on; 0 = never"
+            ),
+            unit="s",
+            bounds=(0.0, 1e6),
             read_only=True,
         ),
     )
     stats_file: str = field(
         default="",
         metadata=param(
-            "write the bridge's counts (JSON) here at shutdown: states, commands on time, "
-            "refused, clamped, trips",
+            description="write the bridge's counts (JSON) here at shutdown",
             read_only=True,
+            details="States, commands on time, refused, clamped, trips.",
         ),
     )
     external_torque_topic: str = field(
         default="",
         metadata=param(
-            "republish the observer's effort_estimate here as sensor_msgs/JointState (name and "
-            "effort) in the driver's joint names and signs, as franka_ros2's "
-            "external_joint_torques; '' = off",
+            description=(
+                "republish the observer's effort_estimate here, in the driver's joints; '' = off"
+            ),
             read_only=True,
+            details=(
+                "As sensor_msgs/JointState (name and effort) in the driver's joint names and "
+                "signs, as franka_ros2's external_joint_torques."
+            ),
+        ),
+    )
+
+
+@dataclass(frozen=True)
+class DriverProfile:
+    """The driver's kind (``profile``): the defaults of its ``state.*`` and ``command.*``."""
+
+    profile: str = field(
+        default=PROFILES[0],
+        metadata=param(
+            description="the driver's kind: the defaults of the command type, delay and effort",
+            choices=PROFILES,
+            read_only=True,
+            details=(
+                "ros2_control_effort: joint_state_broadcaster and an effort "
+                "forward_command_controller. cartesian_wrench: a Touch-like Cartesian force input. "
+                "suite: the suite's own contract."
+            ),
         ),
     )
 
 
 def bridge_specs() -> list[ParamSpec]:
     """The driver's, safety's and run's parameter rows (read-only: they define the session)."""
-    profile = ParamSpec(
-        "profile",
-        PROFILES[0],
-        "the driver's kind: ros2_control_effort (joint_state_broadcaster and an effort "
-        "forward_command_controller), cartesian_wrench (a Touch-like Cartesian force input), "
-        "suite (the suite's own contract)",
-        choices=PROFILES,
-        read_only=True,
-    )
     return [
-        profile,
+        *specs_of(DriverProfile),
         *specs_of(StateSettings, "state.", read_only=True),
         *specs_of(CommandSettings, "command.", read_only=True),
         *specs_of(FrameSettings, "frame.", read_only=True),

@@ -6,11 +6,14 @@ squares (default) or by the step method under a virtual spring (``--method step`
 ``thesis_step`` for the thesis's formulas verbatim).
 With ``--urdf FILE --tip-frame F`` it identifies an arm's joint friction instead (viscous and
 Coulomb per joint, beyond the URDF's rigid body; ``haptic_dob.identification.arm_friction``), judged
-on held-out data. With ``--axes X,Y,Z`` it identifies a Cartesian device per axis (mass, viscous
-and Coulomb friction of each; ``haptic_dob.identification.per_axis``), the point-mass model of a
-Force Dimension device (``--axes fd_x,fd_y,fd_z``). Prints a table, or one JSON line
-(``--json``); ``--write-yaml FILE`` writes the model as a params file (``slide.*``,
-``point_mass.*``, or ``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``, of the observer and
+on held-out data; with ``--inertial`` too, the arm's whole model (every link's mass, centre of
+mass and inertia, physically consistent, with each joint's armature and friction;
+``haptic_dob.identification.arm_model``), written back as a URDF with ``--write-urdf OUT``. With
+``--axes X,Y,Z`` it identifies a Cartesian device per axis (mass, viscous and Coulomb friction of
+each; ``haptic_dob.identification.per_axis``), the point-mass model of a Force Dimension device
+(``--axes fd_x,fd_y,fd_z``). Prints a table, or one JSON line (``--json``); ``--write-yaml FILE``
+writes the model as a params file (``slide.*``, ``point_mass.*``, or ``urdf.viscous_n_m_s_per_rad``
+and ``urdf.coulomb_n_m``, of the observer and
 the controller, the nodes that assume a model) to load after the session's config.
 """
 
@@ -39,6 +42,7 @@ class ArmSpec:
     tip_frame: str
     joints: tuple[str, ...] = ()
     turn_cutoff_hz: float | None = None  # the search for v_c through this low-pass (Hz)
+    inertial: bool = False  # the whole model, not only the friction
 
 
 #: why a fit has no Coulomb friction: the step method separates it from the swings' decay only
@@ -136,6 +140,37 @@ def arm_command(bag: str, topic: str, arm: ArmSpec, as_json: bool, write_yaml: s
         Path(write_yaml).write_text(text, encoding="utf-8")
         if not as_json:
             print(f"model written to {write_yaml}")
+    return 0
+
+
+def inertial_command(
+    bag: str, topic: str, arm: ArmSpec, as_json: bool, write_urdf: str | None
+) -> int:
+    """Identify an arm's whole model, print it, optionally write it back as a URDF."""
+    from haptic_dob.bag.joints import read_joints
+    from haptic_dob.core.models import UrdfModel
+    from haptic_dob.core.models._pinocchio_urdf import read_urdf
+    from haptic_dob.identification.arm_model import Record, identify_arm_model
+    from haptic_dob.identification.arm_model_report import table as model_table
+
+    cad = UrdfModel(arm.urdf, arm.tip_frame, arm.joints or None)
+    js = read_joints(bag, topic, cad.joint_names)
+    record = Record(js.stamps_ns, js.position, js.effort, js.names)
+    try:
+        fit = identify_arm_model(
+            read_urdf(arm.urdf), arm.tip_frame, record, turn_cutoff_hz=arm.turn_cutoff_hz
+        )
+    except IdentificationError as exc:
+        raise InputError(f"{bag}: {exc}") from None
+    if as_json:
+        print(json.dumps({"bag": bag, **fit.as_json()}))
+    else:
+        print(model_table(fit, bag))
+    if write_urdf:
+        note = f"identified from {bag} by haptic-identify, its inertial fit (URDF {arm.urdf})"
+        Path(write_urdf).write_text(fit.urdf(arm.urdf, note), encoding="utf-8")
+        if not as_json:
+            print(f"URDF written to {write_urdf}")
     return 0
 
 
@@ -256,6 +291,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         "milliseconds where the encoders resolve speeds well below it",
     )
     p.add_argument(
+        "--inertial",
+        action="store_true",
+        help="with --urdf: the arm's whole model, not only its joint friction: every link's mass, "
+        "centre of mass and inertia (physically consistent, drawn toward the URDF's where the bag "
+        "does not see them), each joint's armature, viscous and Coulomb friction; a bag with too "
+        "little excitation is refused, naming what it does not see",
+    )
+    p.add_argument(
+        "--write-urdf",
+        metavar="OUT",
+        help="with --inertial: write the URDF with the identified <inertial> and <dynamics> "
+        "(armature and Coulomb turn in <haptic_dob:dynamics>) for the observer's urdf_path",
+    )
+    p.add_argument(
         "--axes",
         metavar="X,Y,Z",
         help="a Cartesian device: identify each of these joints (x, y, z order; fd_x,fd_y,fd_z "
@@ -269,6 +318,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             ("--joints", a.joints),
             ("--turn-cutoff-hz", a.turn_cutoff_hz is not None),
             ("--joint", a.joint),
+            ("--inertial", a.inertial),
+            ("--write-urdf", a.write_urdf),
         )
         clash = [f for f, on in given if on]
         if a.method != "least_squares":
@@ -278,11 +329,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         return run(lambda: axes_command(a.bag, a.topic, parse_axes(a.axes), a.json, a.write_yaml))
     if a.turn_cutoff_hz is not None and not 0.0 < a.turn_cutoff_hz < float("inf"):
         p.error(f"--turn-cutoff-hz must be a positive number of Hz, got {a.turn_cutoff_hz:g}")
+    if (a.inertial or a.write_urdf) and not a.urdf:
+        p.error("--inertial and --write-urdf need --urdf")
+    if a.write_urdf and not a.inertial:
+        p.error("--write-urdf needs --inertial (the friction alone goes to --write-yaml)")
+    if a.inertial and a.write_yaml:
+        p.error(
+            "--write-yaml is the friction fit's; with --inertial the model goes to --write-urdf"
+        )
     if a.urdf:
         if not a.tip_frame:
             p.error("--urdf needs --tip-frame")
         joints = tuple(j for j in (a.joints or "").split(",") if j)
-        arm = ArmSpec(a.urdf, a.tip_frame, joints, a.turn_cutoff_hz)
+        arm = ArmSpec(a.urdf, a.tip_frame, joints, a.turn_cutoff_hz, a.inertial)
+        if a.inertial:
+            return run(lambda: inertial_command(a.bag, a.topic, arm, a.json, a.write_urdf))
         return run(lambda: arm_command(a.bag, a.topic, arm, a.json, a.write_yaml))
     if a.turn_cutoff_hz is not None:
         p.error("--turn-cutoff-hz needs --urdf")

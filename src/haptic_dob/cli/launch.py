@@ -1,30 +1,15 @@
 """``haptic-launch``: bring up a session's node graph from one ``ros__parameters`` YAML.
 
-Every node section of the YAML (``device_node``, ``environment_node``, ``observer_node``,
-``controller_node``, ``recorder_node``) starts through the ``ros2 run`` contract
-(``<prefix>/lib/<pkg>/<exe>`` found with ``ament_index_python``), with
-``--ros-args --params-file CONFIG`` and the namespace. Composition groups say which nodes share a
-process (``<prefix>/lib/haptic_dob/container``, where the loop's messages are handed over in
-process): by default the loop (device, environment, observer, controller) shares one and a
-recorder runs apart; ``--processes`` gives every node its own, ``--composed`` puts all in one,
-``--group`` names groups. The device's process starts last. Ctrl-C or SIGTERM is forwarded to
-every process as SIGTERM (each shuts down cleanly: the device zeroes its effort; a node still
-starting up ends quietly, with no Python traceback as SIGINT would give) and the launcher waits
-for them, killing what is still alive after ``--stop-timeout``. When the device finishes a
-lockstep run (``duration_s``) the others are stopped too.
-
-Network: by default every node's discovery stays on this host
-(``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), so a simulated session never reaches a lab network
-by accident. ``--network subnet`` lets them discover across the subnet, ``--peers`` adds named
-hosts (``ROS_STATIC_PEERS``), and ``--only`` starts a subset: the device on one host and the rest
-on another (see docs/running.md, "Lab network and security"). The launch says which domain and
-discovery range its nodes use, and how each device takes its commands: a device and its
-controller started together share a fresh command token (``command_token``), which every command
-from another process must carry.
-
-A teleoperation YAML (``/master/...`` and ``/slave/...`` sections) starts the two sides' nodes in
-their namespaces, all in one process by default; ``--group`` and ``--only`` take sides there
-(``haptic_dob.launcher.teleop``).
+Each node section starts through the ``ros2 run`` contract (``<prefix>/lib/<pkg>/<exe>`` found
+with ``ament_index_python``) with ``--ros-args --params-file CONFIG`` and the namespace. By
+default the loop (device, environment, observer, controller) shares one process and a recorder
+runs apart; ``--processes``, ``--composed`` and ``--group`` choose otherwise. The device's
+process starts last. Ctrl-C or SIGTERM goes to every process as SIGTERM, what is alive after
+``--stop-timeout`` is killed, and the end of a lockstep run (``duration_s``) stops the others.
+Discovery stays on this host unless ``--network subnet`` (``--peers``: named hosts; ``--only``:
+a subset). A device and its controller started together share a fresh ``command_token``; the
+launch says it, and the domain and discovery range. A teleoperation YAML (``/master/...``,
+``/slave/...`` sections): ``haptic_dob.launcher.teleop``. Guide: docs/running.md.
 """
 
 from __future__ import annotations

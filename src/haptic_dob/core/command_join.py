@@ -58,10 +58,9 @@ def _quiet(_text: str) -> None:
 class CommandJoin:
     """Command k from the stamp-k inputs its mode needs (the controller's decision, ROS-free).
 
-    Feed the inputs as they come (``wall``, ``joints``, ``measured``, ``estimated``; stamps in
-    integer ns). Each returns the command to send (joint efforts, N or N m) or None: a new command
-    once every input of the newest cycle is there, the same command again for a repeated sample,
-    None while an input is missing or for a stale sample.
+    Feed the inputs as they come (``wall``, ``joints``, ``measured``, ``estimated``; stamps in ns):
+    each returns the command to send (joint efforts, N or N m) once every input of the newest cycle
+    is there, the same again for a repeated sample, None while one is missing or for a stale sample.
 
     Args:
         controller: the law and the model's Jacobian (its ``law`` is replaced by ``set_law``).

@@ -70,11 +70,16 @@ class ImpedanceLaw:
 
     mode: ControlMode = field(
         default=ControlMode.OL,
-        metadata=param("control law", choices=tuple(m.value for m in ControlMode)),
+        metadata=param(description="control law", choices=tuple(m.value for m in ControlMode)),
     )
-    kf: float = field(default=0.0, metadata=param("force-feedback gain Kf", "", 0.0, 1e4))
+    kf: float = field(
+        default=0.0, metadata=param(description="force-feedback gain Kf", bounds=(0.0, 1e4))
+    )
     max_force_n: float = field(
-        default=4.0, metadata=param("limit on the commanded force's norm", "N", 1e-3, 1e3)
+        default=4.0,
+        metadata=param(
+            description="limit on the commanded force's norm", unit="N", bounds=(1e-3, 1e3)
+        ),
     )
 
     def __post_init__(self) -> None:

@@ -33,21 +33,27 @@ class VirtualWall:
     point (m), unit normal."""
 
     stiffness_n_per_m: float = field(
-        default=800.0, metadata=param("wall stiffness K", "N/m", 0.0, 1e6)
+        default=800.0, metadata=param(description="wall stiffness K", unit="N/m", bounds=(0.0, 1e6))
     )
     damping_n_s_per_m: float = field(
-        default=0.0, metadata=param("wall damping B", "N s/m", 0.0, 1e4)
+        default=0.0, metadata=param(description="wall damping B", unit="N s/m", bounds=(0.0, 1e4))
     )
     position: Vec3 = field(
-        default=(0.0, 0.0, 0.0), metadata=param("a point on the wall plane (x, y, z)", "m")
+        default=(0.0, 0.0, 0.0),
+        metadata=param(description="a point on the wall plane (x, y, z)", unit="m"),
     )
     normal: Vec3 = field(
         default=(1.0, 0.0, 0.0),
-        metadata=param("wall normal from free space into the wall (x, y, z), non-zero"),
+        metadata=param(
+            description="normal pointing into the wall (x, y, z), non-zero",
+            details="From free space into the wall; of any length but zero (it is normalised).",
+        ),
     )
     two_sided: bool = field(
         default=False,
-        metadata=param("a spring on both sides of the plane (pulls too): identification's spring"),
+        metadata=param(
+            description="a spring on both sides of the plane (pulls too): identification's spring"
+        ),
     )
     _n: Vec3 = field(init=False, repr=False, compare=False)
 

@@ -1,22 +1,15 @@
 """A known force the virtual environment adds: identification's input.
 
-The thesis identified its slide (ch. 4.2) from the response to a 2.4 N force step under an
-80 N/m virtual spring and verified the model (ch. 4.3) with 1.6 N and 3.2 N steps and a 0.6 N,
-2 Hz sine. The environment node renders that input: its force is the wall's plus the excitation
-at ``t``, the sample's time (its stamp), so a lockstep run is deterministic and a batch run gives
-the same samples. The joint state's effort then carries the input, which is all
-``haptic-identify`` needs.
-
-``along``: ``normal`` adds ``force_n(t)`` along the wall normal (the slide's one axis);
-``axes`` adds a signal of its own along each of the base frame's x, y and z (a Cartesian device's
-session, every axis identified from one record): the same kind, each axis a third of
-``period_s`` later than the one before, so the three are not alike. ``chirp``: a logarithmic sweep
-from ``low_hz`` to ``high_hz`` over ``period_s``, repeated; ``multisine``: every multiple of
-``1 / period_s`` in [low_hz, high_hz] at equal amplitude, Schroeder's phases (a low crest
-factor), scaled so that its peak is ``amplitude_n``; every kind stays within +-``amplitude_n``
-per axis. ``hold_n_per_m`` > 0 adds an isotropic spring toward ``hold_at`` (the workspace's
-centre), whose force is in the command like the rest: it keeps a device that nothing else holds
-in its workspace while the excitation moves it.
+The environment's force is the wall's plus the excitation at ``t``, the sample's time (its
+stamp), so a lockstep run is deterministic and a batch run gives the same samples; the joint
+state's effort then carries the input that ``haptic-identify`` fits. ``along``: ``normal`` adds
+``force_n(t)`` along the wall normal; ``axes`` adds a signal of the same kind along each of the
+base frame's x, y and z, each axis a third of ``period_s`` later than the one before. ``chirp``:
+a logarithmic sweep from ``low_hz`` to ``high_hz`` over ``period_s``, repeated; ``multisine``:
+every multiple of ``1 / period_s`` in [low_hz, high_hz] at equal amplitude with Schroeder's
+phases, scaled so that its peak is ``amplitude_n``; every kind stays within +-``amplitude_n``
+per axis. ``hold_n_per_m`` > 0 adds an isotropic spring toward ``hold_at``, its force in the
+command like the rest. Why these inputs: docs/design/identification.md.
 """
 
 from __future__ import annotations
@@ -46,58 +39,74 @@ class Excitation:
 
     kind: str = field(
         default="none",
-        metadata=param("force added: none, step, sine, chirp or multisine", choices=KINDS),
+        metadata=param(
+            description="force added: none, step, sine, chirp or multisine", choices=KINDS
+        ),
     )
     amplitude_n: float = field(
         default=0.0,
-        metadata=param("step size, or the peak of the other kinds per axis", "N", -100.0, 100.0),
+        metadata=param(
+            description="step size, or the peak of the other kinds per axis",
+            unit="N",
+            bounds=(-100.0, 100.0),
+        ),
     )
-    at_s: float = field(default=1.0, metadata=param("start (sample time)", "s", 0.0, 1e7))
+    at_s: float = field(
+        default=1.0, metadata=param(description="start (sample time)", unit="s", bounds=(0.0, 1e7))
+    )
     frequency_hz: float = field(
         default=2.0,
-        metadata=param("frequency of the sine (well below the loop rate)", "Hz", 0.0, 200.0),
+        metadata=param(
+            description="frequency of the sine (well below the loop rate)",
+            unit="Hz",
+            bounds=(0.0, 200.0),
+        ),
     )
     low_hz: float = field(
-        default=1.0, metadata=param("chirp and multisine: lowest frequency", "Hz", 1e-3, 200.0)
+        default=1.0,
+        metadata=param(
+            description="chirp and multisine: lowest frequency", unit="Hz", bounds=(1e-3, 200.0)
+        ),
     )
     high_hz: float = field(
         default=8.0,
         metadata=param(
-            "chirp and multisine: highest frequency (identification's filters bias the mass "
-            "upward above about 10 Hz)",
-            "Hz",
-            1e-3,
-            200.0,
+            description="chirp and multisine: highest frequency",
+            unit="Hz",
+            bounds=(1e-3, 200.0),
+            details=("Identification's filters bias the mass upward above about 10 Hz."),
         ),
     )
     period_s: float = field(
         default=10.0,
         metadata=param(
-            "chirp: one sweep (then it repeats); multisine: its period (frequency step 1/period)",
-            "s",
-            0.1,
-            1e4,
+            description="chirp: one sweep (then it repeats); multisine: its period",
+            unit="s",
+            bounds=(0.1, 1e4),
+            details="The multisine's frequency step is 1/period.",
         ),
     )
     along: str = field(
         default="normal",
         metadata=param(
-            "normal: along the wall normal; axes: a signal of its own along each of x, y, z",
+            description=(
+                "normal: along the wall normal; axes: a signal of its own along each of x, y, z"
+            ),
             choices=ALONG,
         ),
     )
     hold_n_per_m: float = field(
         default=0.0,
         metadata=param(
-            "stiffness of an isotropic spring toward hold_at (0: none), keeping a device that "
-            "nothing else holds in its workspace",
-            "N/m",
-            0.0,
-            1e4,
+            description="stiffness of an isotropic spring toward hold_at; 0 = none",
+            unit="N/m",
+            bounds=(0.0, 1e4),
+            details="It keeps a device that nothing else holds in its workspace.",
         ),
     )
     hold_at: tuple[float, float, float] = field(
-        default=(0.0, 0.0, 0.0), metadata=param("where the holding spring pulls (x, y, z)", "m")
+        default=(0.0, 0.0, 0.0),
+        metadata=param(description="where the holding spring pulls (x, y, z)", unit="m"),
     )
     # the multisine's components: angular frequencies (rad/s), each axis's phases (rad, (3, n)),
     # the scale of a unit peak

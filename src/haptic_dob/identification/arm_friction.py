@@ -101,7 +101,7 @@ def identify_arm_friction(
     if not dt > 0.0 or not np.all(np.isfinite(position)) or not np.all(np.isfinite(effort)):
         raise IdentificationError("the stamps do not increase, or a value is not finite")
     f = MotionFilters.design(dt, cutoff_hz)
-    wide = f if turn_cutoff_hz is None else _turn_filters(dt, cutoff_hz, turn_cutoff_hz)
+    wide = f if turn_cutoff_hz is None else turn_filters(dt, cutoff_hz, turn_cutoff_hz)
     # continuous joints a driver wraps to (-pi, pi]; no other joint jumps by pi in one sample
     position = np.unwrap(position, axis=0)
     v_light = f.light_velocity(position)
@@ -123,7 +123,7 @@ def identify_arm_friction(
                 f"{name}: too little motion to fit ({len(moving) // f.step} usable samples faster "
                 f"than {min_speed:g}/s before the held-out part, {len(test_idx)} in it)"
             )
-        c = _turn_speed(
+        c = turn_speed(
             f,
             wide,
             v_light[:, j],
@@ -131,7 +131,7 @@ def identify_arm_friction(
             (v_w[:, j], r_w[:, j], every_w),
             str(name),
         )
-        s = _coulomb(f, v_light[:, j], c)
+        s = coulomb_term(f, v_light[:, j], c)
         theta, std, _ = fit(np.column_stack([v[every, j], s[every]]), r[every, j], str(name))
         rt = r[test_idx, j]
         pred = np.column_stack([v[test_idx, j], s[test_idx]]) @ theta
@@ -160,7 +160,7 @@ def _unexplained(
     return f.effort(effort) - rigid_effort, v
 
 
-def _turn_filters(dt: float, cutoff_hz: float, turn_cutoff_hz: float) -> MotionFilters:
+def turn_filters(dt: float, cutoff_hz: float, turn_cutoff_hz: float) -> MotionFilters:
     """The search's filters: a low-pass no narrower than the fit's; ``IdentificationError``
     naming ``turn_cutoff_hz`` otherwise."""
     if not turn_cutoff_hz >= cutoff_hz:
@@ -174,12 +174,12 @@ def _turn_filters(dt: float, cutoff_hz: float, turn_cutoff_hz: float) -> MotionF
         raise IdentificationError(f"turn_cutoff_hz: {exc}") from None
 
 
-def _coulomb(f: MotionFilters, v_light: Arr, speed: float) -> Arr:
+def coulomb_term(f: MotionFilters, v_light: Arr, speed: float) -> Arr:
     """The Coulomb term through ``f``: the sign (``speed`` 0) or ``tanh(v / speed)``."""
     return f.coulomb_term(v_light) if speed == 0.0 else f.smooth(np.tanh(v_light / speed))
 
 
-def _turn_speed(
+def turn_speed(
     f: MotionFilters,
     wide: MotionFilters,
     v_light: Arr,
@@ -195,9 +195,9 @@ def _turn_speed(
     v_w, r_w, every_w = terms_w
 
     def residual(c: float) -> float:
-        s = _coulomb(f, v_light, c)
+        s = coulomb_term(f, v_light, c)
         theta, _, _ = fit(np.column_stack([v[every], s[every]]), r[every], where)
-        s_w = s if wide is f else _coulomb(wide, v_light, c)
+        s_w = s if wide is f else coulomb_term(wide, v_light, c)
         e = r_w[every_w] - np.column_stack([v_w[every_w], s_w[every_w]]) @ theta
         return float(e @ e)
 

@@ -4,16 +4,14 @@ namespaces (``haptic_dob.teleop.graph``), all in one process by default.
 A YAML with ``/master/...`` or ``/slave/...`` sections is a teleoperation graph: each node's
 parameters are its sections overlaid (``node_values``), written to a params file under the
 node's full name; ``--set NS/NODE:PARAM=VALUE`` overrides one node's, ``**/NODE:`` the node of
-both sides. ``--composed`` (the default) runs all nodes in one container (every message, the
-channel's link too, handed over in process; a stall stops both sides alike), ``--processes`` one
+both sides. ``--composed`` (the default) runs all nodes in one container, ``--processes`` one
 process each, ``--group`` names groups (``master``, ``slave`` or ``NS/NODE`` items: ``--group
 master --group slave`` gives each side a process and each device a CPU; the devices'
-``start_with`` starts their clocks together). ``--only`` starts the named sides or nodes: the
-slave on another host, with ``--network subnet``. ``--record BAG`` adds a ``recorder_node`` in
-the root namespace, in a process of its own: it records both sides' topics and the channel's
-(``recorded_topics``), snapshots the nodes of ``/master`` and ``/slave``, and both devices wait
-for it (``haptic-teleop --bag BAG`` analyses the bag). The options of a single loop's launch
-``--namespace``, ``--pin`` and ``--cpu-latency`` are refused.
+``start_with`` starts their clocks together). ``--only`` starts the named sides or nodes (the
+slave on another host, with ``--network subnet``). ``--record BAG`` adds a ``recorder_node`` in
+the root namespace, in a process of its own, recording both sides' and the channel's topics
+(``recorded_topics``) and snapshotting ``/master`` and ``/slave``; both devices wait for it.
+``--namespace``, ``--pin`` and ``--cpu-latency`` are refused. Guide: docs/teleoperation.md.
 """
 
 from __future__ import annotations

@@ -14,8 +14,6 @@ and recipes: docs/devices.md.
 
 from __future__ import annotations
 
-import json
-import math
 import os
 import sys
 import time
@@ -25,23 +23,23 @@ from rclpy.context import Context
 
 from haptic_dob.bridge.driver_settings import DriverSettings
 from haptic_dob.bridge.loop import BridgeLoop, Send
+from haptic_dob.bridge.report import bridge_status, write_stats
 from haptic_dob.bridge.settings import RunSettings, SafetySettings, bridge_specs
 from haptic_dob.bridge.start import StartGate
 from haptic_dob.bridge.state import StateReader, check_cartesian
 from haptic_dob.core.models.factory import build_model, model_specs
 from haptic_dob.nodes.command_input import CommandInput
-from haptic_dob.nodes.common import (
-    command_authority_specs,
-    input_specs,
-    loop_specs,
-    main_for,
-    missing_nodes,
-    process_specs,
+from haptic_dob.nodes.common import main_for, missing_nodes
+from haptic_dob.nodes.settings import (
+    RELIABLE_INPUTS,
+    CommandInputSettings,
+    LoopInputs,
+    LoopTiming,
+    ProcessSettings,
 )
 from haptic_dob.runtime.discovery import exposure_warning
-from haptic_dob.runtime.params import ParamSpec, build
-from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
+from haptic_dob.runtime.params import ParamSpec, build, specs_of
+from haptic_dob.runtime.ros.diagnostics import Diagnostics, Report, report_of
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.driver_wire import (
@@ -54,17 +52,17 @@ from haptic_msgs_py.driver_wire import (
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.driver_io import driver_publisher, driver_subscription
 from haptic_msgs_py.ros.loop_io import LoopPublisher, LoopSubscription
-from haptic_msgs_py.topics import EE_POSE, EE_TWIST, EFFORT_COMMAND, EFFORT_ESTIMATE, JOINT_STATES
+from haptic_msgs_py.topics import EE_POSE, EE_TWIST, EFFORT_ESTIMATE, JOINT_STATES
 from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
 
 
 def bridge_node_specs() -> list[ParamSpec]:
     """Every parameter of the bridge node."""
     return [
-        *loop_specs(),
-        *input_specs("reliable"),
-        *command_authority_specs(),
-        *process_specs(),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs, defaults=RELIABLE_INPUTS),
+        *specs_of(CommandInputSettings),
+        *specs_of(ProcessSettings),
         *model_specs(),
         *bridge_specs(),
     ]
@@ -79,8 +77,7 @@ class BridgeNode(LoopNode):
         name: str = "bridge_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, bridge_node_specs())
+        super().__init__(name, specs=bridge_node_specs(), context=context, namespace=namespace)
         v = self.params.values
         self.model = build_model(v)
         driver = DriverSettings.of(v)
@@ -89,7 +86,9 @@ class BridgeNode(LoopNode):
         self.reader = StateReader(
             driver.state, driver.frame, self.model.joint_names, 1 / v["rate_hz"]
         )
-        self._check_topics(driver)
+        driver.check_apart(self.resolve_topic_name)
+        if self.reader.pose:
+            check_cartesian(self.model)
         self._news: list[str] = []
         joints = self.reader.driver_joints
         self.loop = BridgeLoop(driver, safety, self.model, joints, v["rate_hz"], self._news.append)
@@ -128,26 +127,12 @@ class BridgeNode(LoopNode):
         self.diagnostics = Diagnostics(self, self._report)
         unsent = self.loop.map.unsent
         self.log.info(
-            f"bridge to a {driver.profile} driver: state {s.topic} ({s.type}, {s.reliability}), "
-            f"command {c.topic} ({c.type}, {c.reliability}), model {v['model']} "
-            f"{list(self._names)}" + (f"; not commanded: {list(unsent)}" if unsent else "")
+            f"bridge to {driver.describe()}, model {v['model']} {list(self._names)}"
+            + (f"; not commanded: {list(unsent)}" if unsent else "")
         )
         exposed = exposure_warning(os.environ)
         if exposed:
             self.log.warning(exposed)
-
-    def _check_topics(self, driver: DriverSettings) -> None:
-        """The driver's topics are not the loop's own (a loop in the driver's namespace)."""
-        ours = {self.resolve_topic_name(t) for t in (JOINT_STATES, EFFORT_COMMAND)}
-        for topic in (driver.state.topic, driver.command.topic):
-            if self.resolve_topic_name(topic) in ours:
-                raise ValueError(
-                    f"the driver's {topic} is the loop's own topic here: run the loop in a "
-                    "namespace of its own (-r __ns:=/haptic) and name the driver's topics "
-                    "absolutely (/fd/joint_states)"
-                )
-        if self.reader.pose:
-            check_cartesian(self.model)
 
     def _mismatch(self, text: str) -> None:
         self.log.error(text, throttle_duration_sec=5.0)
@@ -239,29 +224,14 @@ class BridgeNode(LoopNode):
         return ""
 
     def _report(self) -> Report:
-        values = {
-            k: (f"{x:.2f}" if isinstance(x, float) else x) for k, x in self.loop.counts().items()
-        }
-        values.update(self._commands.report())
-        why = self.loop.status()
-        if why:
-            return WARN, f"{why}: zero command", values
-        if self._commands.refusing():
-            return WARN, "refused commands from a publisher not the loop's", values
-        return OK, "running", values
+        return report_of(bridge_status(self.loop, self._commands.report(), self._commands.refusing))
 
     def on_shutdown(self) -> None:
         """Zero to the driver first (acknowledged before the process ends, when reliable)."""
         self._send(self.loop.stop())
         self.log.info("shutdown: zero command sent to the driver")
         if self.run.stats_file:
-            counts = self.loop.counts()
-            clean = {
-                k: (None if isinstance(x, float) and math.isnan(x) else x)
-                for k, x in counts.items()
-            }
-            with open(self.run.stats_file, "w", encoding="utf-8") as fh:
-                json.dump(clean, fh, indent=2)
+            write_stats(self.run.stats_file, self.loop.counts())
 
 
 def main(args: list[str] | None = None) -> int:

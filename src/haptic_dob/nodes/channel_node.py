@@ -24,10 +24,10 @@ from rclpy.context import Context
 
 from haptic_dob.core.models.factory import build_model, model_specs
 from haptic_dob.core.models.slide import SlideModel
-from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
+from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.settings import ChannelEnd, LoopInputs, LoopTiming, ProcessSettings
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_dob.teleop.ends import MasterEnd, PortMessage, SlaveEnd
 from haptic_dob.teleop.graph import TO_MASTER, TO_SLAVE
@@ -45,7 +45,6 @@ from haptic_msgs_py.topics import (
 )
 from haptic_msgs_py.values import JointSample, StampedVector
 
-ROLES = ("master", "slave")
 PORT_NAMES = ("x", "y", "z", "energy", "silent")
 
 
@@ -81,17 +80,11 @@ def from_wire(js: JointSample) -> PortMessage:
 def channel_node_specs() -> list[ParamSpec]:
     """Every parameter of the channel node."""
     return [
-        *loop_specs(),
-        *input_specs("best_effort"),
-        *process_specs(),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs),
+        *specs_of(ProcessSettings),
         *model_specs(),
-        ParamSpec("role", "master", "which end of the channel", choices=ROLES, read_only=True),
-        ParamSpec(
-            "wait_for_peer",
-            True,
-            "lockstep: sample k waits for the peer's messages that can be due by k",
-            read_only=True,
-        ),
+        *specs_of(ChannelEnd),
         *specs_of(TeleopSettings, "teleop.", read_only=True),
         *specs_of(ChannelSettings, "channel.", read_only=True),
     ]
@@ -106,8 +99,7 @@ class ChannelNode(LoopNode):
         name: str = "channel_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, channel_node_specs())
+        super().__init__(name, specs=channel_node_specs(), context=context, namespace=namespace)
         v = self.params.values
         teleop = build(TeleopSettings, v, "teleop.")
         channel = build(ChannelSettings, v, "channel.")

@@ -8,7 +8,7 @@ process listens on DDS only while the graph shows a publisher of the topic outsi
 every ``LOOK_EVERY_S``): a stray publisher's commands are refused, counted and named there too,
 and while there is none this costs the loop nothing. While there is one, the loop's own
 controller sends its commands on DDS as well (a reader is matched) and the device drops those
-copies. Parameters: ``haptic_dob.nodes.common.command_authority_specs``.
+copies. Parameters: ``haptic_dob.nodes.settings.CommandInputSettings``.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ class CommandInput:
         node: the device end's node.
         take: where commands that move the device go.
         qos: the input's QoS.
-        values: the node's parameter values (``command_authority_specs``).
+        values: the node's parameter values (``CommandInputSettings``).
     """
 
     def __init__(

@@ -1,117 +1,13 @@
-"""Parameters and helpers every loop node shares (rate, frames, loop mode)."""
+"""Helpers every node executable shares: ``--help``, ``main``, the graph's missing nodes.
+
+The parameter groups the loop nodes share are ``haptic_dob.nodes.settings``.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 
 from haptic_dob.runtime.params import ParamSpec
-from haptic_msgs_py.topics import DEFAULT_BASE_FRAME, INPUT_RELIABILITY
-
-CLOCK_MODES = ("lockstep", "realtime")
-
-
-def loop_specs() -> list[ParamSpec]:
-    """``rate_hz`` and the base frame: the same on every node of a session (YAML ``/**``)."""
-    return [
-        ParamSpec("rate_hz", 1000.0, "control rate of the loop", "Hz", 1.0, 1e5, read_only=True),
-        ParamSpec(
-            "base_frame", DEFAULT_BASE_FRAME, "frame of poses, twists and wrenches", read_only=True
-        ),
-    ]
-
-
-def input_specs(default: str) -> list[ParamSpec]:
-    """How a node with loop inputs subscribes to them: ``default`` is ``reliable`` for a command
-    input (the device's ``effort_command``), ``best_effort`` for sensor streams (environment,
-    controller), as ROS 2 treats commands and sensor data."""
-    return [
-        ParamSpec(
-            "input_reliability",
-            default,
-            "QoS reliability of this node's loop inputs: reliable (a one-off message such as "
-            "ros2 topic pub --once is asked for again and arrives while its publisher lives; "
-            "the default of the device's effort_command) "
-            "or best_effort (no acknowledgements, the default of the sensor streams: nodes in "
-            "separate processes cycle faster, see BENCHMARKS.md, and a message sent before the "
-            "reader matched its writer can be lost). Nodes sharing a process hand values over "
-            "in process either way",
-            choices=INPUT_RELIABILITY,
-            read_only=True,
-        )
-    ]
-
-
-def command_authority_specs() -> list[ParamSpec]:
-    """Who may command a device end (the simulated device node, the device bridge): the command
-    source, the session's token, the bench switch (``haptic_dob.core.command_authority``)."""
-    return [
-        ParamSpec(
-            "command_source",
-            "controller_node",
-            "the node whose effort_command moves the device from another process: a name in "
-            "this namespace, or fully qualified (commands handed over in this process, the loop "
-            "composed, always do)",
-            read_only=True,
-        ),
-        ParamSpec(
-            "command_token",
-            "",
-            "this session's command token: a command from another process moves the device only "
-            "when its layout label carries it (effort@<stamp>#<token>); haptic-launch writes a "
-            "fresh one for a device and its controller at every launch. '' = the token of "
-            "command_source's commands, taken while the graph shows that node (name and GID) as "
-            "the only publisher. Not a secret from anyone on the network (docs/safety.md)",
-            read_only=True,
-        ),
-        ParamSpec(
-            "open_command_input",
-            False,
-            "take effort_command from any publisher (bench work: ros2 topic pub, a tool of your "
-            "own); false: only command_source's, the others refused, counted in /diagnostics and "
-            "named once each in the log. At start-up only: no one on the network can open it "
-            "with ros2 param set",
-            read_only=True,
-        ),
-    ]
-
-
-def command_token_spec() -> ParamSpec:
-    """The token a command source's ``effort_command`` carries (the controllers)."""
-    return ParamSpec(
-        "command_token",
-        "",
-        "the token this node's effort_command carries in its layout label "
-        "(effort@<stamp>#<token>), by which the device takes commands from another process; "
-        "haptic-launch writes the session's; '' = a fresh random one at every start",
-        read_only=True,
-    )
-
-
-def process_specs() -> list[ParamSpec]:
-    """Per-process settings of a loop node (``cpu_affinity``, ``cpu_latency_us``)."""
-    return [
-        ParamSpec(
-            "cpu_affinity",
-            [],
-            "CPUs this node's process runs on, every thread (as ros2_control's cpu_affinity); "
-            "[] = wherever the system schedules it. haptic-launch --pin fills it per node",
-            read_only=True,
-            items=int,
-        ),
-        ParamSpec(
-            "cpu_latency_us",
-            -1,
-            "while this process runs, CPUs use only idle states whose advertised exit latency "
-            "is at most this (Linux PM QoS request on /dev/cpu_dma_latency, held open; needs "
-            "write access to it, root as a rule; a node that cannot make it does not start): "
-            "0 = idle CPUs poll and wake at once (costs power; on a virtual machine only 0 "
-            "helps). -1 = no request. haptic-launch --cpu-latency sets it on every loop node",
-            unit="us",
-            min=-1,
-            max=1_000_000,
-            read_only=True,
-        ),
-    ]
 
 
 def usage(node_class: type, specs: list[ParamSpec]) -> str:

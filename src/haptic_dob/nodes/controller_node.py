@@ -32,20 +32,20 @@ from typing import Any
 from rclpy.context import Context
 
 from haptic_dob.core.command_authority import new_token
-from haptic_dob.core.command_join import FALLBACKS, CommandJoin
+from haptic_dob.core.command_join import CommandJoin
 from haptic_dob.core.control import HandForce, ImpedanceController, ImpedanceLaw
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import (
-    command_token_spec,
-    input_specs,
-    loop_specs,
-    main_for,
-    process_specs,
+from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.settings import (
+    CommandOutputSettings,
+    ControllerSettings,
+    LoopInputs,
+    LoopTiming,
+    ProcessSettings,
 )
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
@@ -64,42 +64,13 @@ from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
 def controller_node_specs() -> list[ParamSpec]:
     """Every parameter of the controller node."""
     return [
-        *loop_specs(),
-        *input_specs("best_effort"),
-        command_token_spec(),
-        *process_specs(),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs),
+        *specs_of(CommandOutputSettings),
+        *specs_of(ProcessSettings),
         *model_specs(),
         *specs_of(ImpedanceLaw),
-        ParamSpec(
-            "input_warn_s",
-            2.0,
-            "warn when an input of a pending cycle is this late",
-            "s",
-            0.01,
-            3600.0,
-        ),
-        ParamSpec(
-            "warm_inputs",
-            True,
-            "subscribe to every mode's force input, so a switch to CL or DOB finds it flowing "
-            "(false: only the start mode's input; cheaper; a switch to another mode is refused)",
-            read_only=True,
-        ),
-        ParamSpec(
-            "fallback",
-            "zero",
-            "what to render when the mode's force input stops: zero force or OL",
-            choices=FALLBACKS,
-        ),
-        ParamSpec(
-            "input_timeout_s",
-            0.02,
-            "the mode's force input counts as stopped when its newest sample is this much sample "
-            "time older than the cycle",
-            "s",
-            0.001,
-            10.0,
-        ),
+        *specs_of(ControllerSettings),
     ]
 
 
@@ -112,14 +83,13 @@ class ControllerNode(LoopNode):
         name: str = "controller_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, controller_node_specs(), self._settings, self._apply)
+        super().__init__(name, specs=controller_node_specs(), context=context, namespace=namespace)
         values = self.params.values
         self.model = build_model(values)
         self.period_ns = period_ns(values["rate_hz"])
         log = self.log
         self.join = CommandJoin(
-            ImpedanceController(self.model, self.params.settings),
+            ImpedanceController(self.model, build(ImpedanceLaw, values)),
             self.period_ns,
             needs_q=not self.model.constant_jacobian,
             input_timeout_ns=values["input_timeout_s"] * 1e9,
@@ -148,6 +118,7 @@ class ControllerNode(LoopNode):
         for topic, codec, callback in inputs:
             LoopSubscription(self, topic, codec, callback, profile)
         self.diagnostics = Diagnostics(self, self._report)
+        self.params.set_validator(self._settings, self._apply)
 
     @property
     def controller(self) -> ImpedanceController:
@@ -157,13 +128,12 @@ class ControllerNode(LoopNode):
     # --- parameters ------------------------------------------------------------------------
     def next_sample_ns(self) -> int | None:
         """The command after the newest sent is the first computed with a new law."""
-        join = getattr(self, "join", None)
-        return None if join is None or join.sent_ns < 0 else join.sent_ns + self.period_ns
+        sent = self.join.sent_ns
+        return None if sent < 0 else sent + self.period_ns
 
     def _settings(self, values: Mapping[str, Any]) -> ImpedanceLaw:
         law = build(ImpedanceLaw, values)
-        if hasattr(self, "join"):  # a change at run time, not the start-up values
-            self.join.check_switch(law)
+        self.join.check_switch(law)
         return law
 
     def _apply(self, law: ImpedanceLaw) -> None:

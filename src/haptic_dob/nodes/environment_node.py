@@ -19,10 +19,10 @@ from rclpy.context import Context
 from haptic_dob.core.cycle import wall_force
 from haptic_dob.core.environment import VirtualWall
 from haptic_dob.core.excitation import Excitation
-from haptic_dob.nodes.common import input_specs, loop_specs, main_for, process_specs
+from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.settings import LoopInputs, LoopTiming, ProcessSettings
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
@@ -35,9 +35,9 @@ from haptic_msgs_py.values import StampedVector
 def environment_node_specs() -> list[ParamSpec]:
     """Every parameter of the environment node (the wall and the excitation change at run time)."""
     return [
-        *loop_specs(),
-        *input_specs("best_effort"),
-        *process_specs(),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs),
+        *specs_of(ProcessSettings),
         *specs_of(VirtualWall),
         *specs_of(Excitation, "excitation."),
     ]
@@ -59,9 +59,8 @@ class EnvironmentNode(LoopNode):
         name: str = "environment_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, environment_node_specs(), self._settings, self._apply)
-        self.wall, self.excitation = self.params.settings
+        super().__init__(name, specs=environment_node_specs(), context=context, namespace=namespace)
+        self.wall, self.excitation = self._settings(self.params.values)
         self._adds = self.excitation if self.excitation.active else None  # what wall_force adds
         self._pose: StampedVector | None = None
         self._twist: StampedVector | None = None
@@ -75,6 +74,7 @@ class EnvironmentNode(LoopNode):
         LoopSubscription(self, EE_POSE, codecs.POSE, self._on_pose, inputs)
         LoopSubscription(self, EE_TWIST, codecs.TWIST, self._on_twist, inputs)
         self.diagnostics = Diagnostics(self, self._report)
+        self.params.set_validator(self._settings, self._apply)
 
     def _report(self) -> Report:
         w = self.wall
@@ -92,7 +92,7 @@ class EnvironmentNode(LoopNode):
 
     def next_sample_ns(self) -> int | None:
         """The pose after the newest rendered is the first rendered with a changed wall."""
-        last = getattr(self, "_emitted_ns", -1)
+        last = self._emitted_ns
         return None if last < 0 else last + self._period_ns
 
     @staticmethod

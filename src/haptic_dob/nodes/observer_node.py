@@ -22,10 +22,10 @@ from haptic_dob.core.models.base import DeviceModel
 from haptic_dob.core.models.factory import build_model, model_specs
 from haptic_dob.core.observers.disturbance import DisturbanceObserver
 from haptic_dob.core.observers.factory import ObserverSettings
-from haptic_dob.nodes.common import loop_specs, main_for, process_specs
+from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.settings import LoopTiming, ProcessSettings
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import ERROR, OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
@@ -37,7 +37,12 @@ from haptic_msgs_py.values import JointSample, StampedVector
 
 def observer_node_specs() -> list[ParamSpec]:
     """Every parameter of the observer node."""
-    return [*loop_specs(), *process_specs(), *model_specs(), *specs_of(ObserverSettings)]
+    return [
+        *specs_of(LoopTiming),
+        *specs_of(ProcessSettings),
+        *model_specs(),
+        *specs_of(ObserverSettings),
+    ]
 
 
 class ObserverNode(LoopNode):
@@ -49,12 +54,12 @@ class ObserverNode(LoopNode):
         name: str = "observer_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, observer_node_specs(), self._settings, self._apply)
+        super().__init__(name, specs=observer_node_specs(), context=context, namespace=namespace)
         values = self.params.values
         self.model: DeviceModel = build_model(values)
         self.period_ns = period_ns(values["rate_hz"])
-        self.observer = self._make_observer(self.params.settings)
+        settings = self._settings(values)
+        self.observer: DisturbanceObserver = settings.build(self.model, self.period_ns * 1e-9)
         self.joints = JointMap(self.model.joint_names)
         self._last_ns = -1
         self.gaps = 0  # samples that came two periods or more after the previous one
@@ -78,6 +83,7 @@ class ObserverNode(LoopNode):
         )
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.diagnostics = Diagnostics(self, self._report)
+        self.params.set_validator(self._settings, self._apply)
 
     def _report(self) -> Report:
         values = {
@@ -96,7 +102,7 @@ class ObserverNode(LoopNode):
 
     def next_sample_ns(self) -> int | None:
         """The sample after the newest estimated is the first with a new gain."""
-        last = getattr(self, "_last_ns", -1)
+        last = self._last_ns
         return None if last < 0 else last + self.period_ns
 
     def drain_marker(self) -> int:
@@ -106,9 +112,6 @@ class ObserverNode(LoopNode):
     @staticmethod
     def _settings(values: Mapping[str, Any]) -> ObserverSettings:
         return build(ObserverSettings, values)
-
-    def _make_observer(self, settings: ObserverSettings) -> DisturbanceObserver:
-        return settings.build(self.model, self.period_ns * 1e-9)
 
     def _apply(self, settings: ObserverSettings) -> None:
         """A new gain or limit, taken on the next sample without a jump of the estimate."""

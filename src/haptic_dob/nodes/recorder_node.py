@@ -49,7 +49,6 @@ from haptic_dob.recorder.recording import Recording
 from haptic_dob.recorder.settings import new_bag_path, progress_topic, recorder_specs
 from haptic_dob.recorder.snapshots import ParameterSnapshot, SnapshotTracker
 from haptic_dob.recorder.topics import TopicKind, parse_topics
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.raw import rclpy_type
@@ -80,8 +79,7 @@ class RecorderNode(LoopNode):
     def __init__(
         self, context: Context | None = None, name: str = "recorder_node", **kwargs: Any
     ) -> None:
-        super().__init__(name, context=context, **kwargs)
-        self.params = ParameterTable(self, recorder_specs())
+        super().__init__(name, specs=recorder_specs(), context=context, **kwargs)
         v = self.params.values
         topics = parse_topics(v["topics"])
         classes = {}

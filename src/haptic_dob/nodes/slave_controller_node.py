@@ -7,7 +7,9 @@ impedance around it plus the model's gravity gives the efforts, saturated at the
 Command k goes out once both inputs of stamp k are here, labelled with the stamp and the
 session's command token (``command_token``, as the controller node's); a sample
 answered already is answered again with the same command (a lockstep re-send). The gains are
-set at the first sample's pose (``slave.*``, read-only).
+set at the first sample's pose (``slave.*``, read-only). With ``slave.trajectory_path`` it plays
+that excitation instead (``SlaveController.play``, time from the first sample's stamp): command k
+goes out on joint_states k alone, and ``pose_desired`` is not read.
 """
 
 from __future__ import annotations
@@ -20,16 +22,15 @@ from rclpy.context import Context
 from haptic_dob.core.command_authority import new_token
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.factory import build_model, model_specs
-from haptic_dob.nodes.common import (
-    command_token_spec,
-    input_specs,
-    loop_specs,
-    main_for,
-    process_specs,
+from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.settings import (
+    CommandOutputSettings,
+    LoopInputs,
+    LoopTiming,
+    ProcessSettings,
 )
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_dob.teleop.slave import SlaveController, SlaveImpedance
 from haptic_msgs_py import codecs
@@ -42,10 +43,10 @@ from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
 def slave_controller_node_specs() -> list[ParamSpec]:
     """Every parameter of the slave controller node."""
     return [
-        *loop_specs(),
-        *input_specs("best_effort"),
-        command_token_spec(),
-        *process_specs(),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs),
+        *specs_of(CommandOutputSettings),
+        *specs_of(ProcessSettings),
         *model_specs(),
         *specs_of(SlaveImpedance, "slave.", read_only=True),
     ]
@@ -60,8 +61,9 @@ class SlaveControllerNode(LoopNode):
         name: str = "slave_controller_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, slave_controller_node_specs())
+        super().__init__(
+            name, specs=slave_controller_node_specs(), context=context, namespace=namespace
+        )
         v = self.params.values
         model = build_model(v)
         self.controller = SlaveController(
@@ -71,11 +73,13 @@ class SlaveControllerNode(LoopNode):
         self._q: tuple[int, list[float], list[float]] | None = None
         self._target: StampedVector | None = None
         self._last: EffortCommand | None = None
+        self._first_ns: int | None = None  # the first sample's stamp (a trajectory's t = 0)
         self._token = v["command_token"] or new_token()
         self._pub = LoopPublisher(self, EFFORT_COMMAND, codecs.EFFORT, qos.LOOP)
         inputs = qos.loop_input(v["input_reliability"])
         LoopSubscription(self, JOINT_STATES, codecs.JOINT_STATE, self._on_joints, inputs)
-        LoopSubscription(self, POSE_DESIRED, codecs.POSE, self._on_target, inputs)
+        if self.controller.trajectory is None:
+            LoopSubscription(self, POSE_DESIRED, codecs.POSE, self._on_target, inputs)
         self.diagnostics = Diagnostics(self, self._report)
 
     def _on_joints(self, js: JointSample) -> None:
@@ -96,16 +100,22 @@ class SlaveControllerNode(LoopNode):
 
     def _step(self) -> None:
         joints, target = self._q, self._target
-        if joints is None or target is None or joints[0] != target.stamp_ns:
+        playing = self.controller.trajectory is not None
+        if joints is None or not (playing or (target is not None and joints[0] == target.stamp_ns)):
             return
-        k = target.stamp_ns
+        k = joints[0]
         last = self._last
         if last is not None and k <= (last.stamp_ns or 0):
             if k == last.stamp_ns:
                 self._pub.publish(last)  # the same sample again: the same command
             return
         _, q, qd = joints
-        tau = self.controller.command(np.asarray(q), np.asarray(qd), target.vector)
+        if playing:
+            self._first_ns = k if self._first_ns is None else self._first_ns
+            tau = self.controller.play(np.asarray(q), np.asarray(qd), (k - self._first_ns) * 1e-9)
+        else:
+            assert target is not None
+            tau = self.controller.command(np.asarray(q), np.asarray(qd), target.vector)
         self._last = EffortCommand(k, tuple(tau), self._token)
         self._pub.publish(self._last)
         self.diagnostics.tick()
@@ -116,9 +126,11 @@ class SlaveControllerNode(LoopNode):
 
     def _report(self) -> Report:
         values = {"commands": self.diagnostics.cycles}
+        playing = self.controller.trajectory is not None
         if self.diagnostics.rate_hz == 0.0:
-            return WARN, "no joint_states/pose_desired pairs in the last second", values
-        return OK, "tracking", values
+            what = "joint_states" if playing else "joint_states/pose_desired pairs"
+            return WARN, f"no {what} in the last second", values
+        return OK, "playing the trajectory" if playing else "tracking", values
 
 
 def main(args: list[str] | None = None) -> int:

@@ -1,26 +1,17 @@
 """The bag being recorded: each message's bytes written as they came, counted per topic.
 
-Bag (log) time, ``log_time``:
-
-- ``session`` (the default): the session's own time, as ``ros2 bag record --use-sim-time`` logs
-  it. A message of the loop's topics is logged at its own stamp (the sample it belongs to: the
-  device's ``k * T``, also on ``/clock``), anything else (parameter events, the snapshots,
-  other topics, an unlabelled command) at the newest session time received so far: the newest
-  loop stamp, or ``/clock`` (``observe_clock``) where no loop topic is recorded; 0 before the
-  first. ``ros2 bag play --clock`` of such a bag then publishes ``/clock`` on the samples' time
-  base, and a lockstep run gives the same log times every time.
-- ``receive``: the wall-clock receive time (ns), as ``ros2 bag record`` without it (a graph
-  whose stamps are the system clock).
-
-Parameter snapshots go on ``/parameter_events`` beside the live events. What was written goes
-into complete records on disk whenever a topic's newest stamp is ``DURABLE_NS`` of session time
-past where it was at the last time (and at least that often on the monotonic clock, for messages
-without a stamp), so a killed recorder loses at most the last ``DURABLE_NS`` of session time of
-what it wrote, however fast the session runs (``haptic-record --recover``). A topic's connection
-is added to the bag at its first message (or at the close), with the QoS profiles its publishers
-offer then (``offered``), as ``ros2 bag record`` adds a topic when it subscribes. Closing writes
-the counts into the bag's metadata (custom data ``haptic_dob.recorder``) so the bag is readable
-and says what the recorder received and wrote.
+Bag (log) time, ``log_time``: ``session`` (the default) is the session's own time, as
+``ros2 bag record --use-sim-time`` logs it: a message of the loop's topics at its own stamp,
+anything else (parameter events, the snapshots, other topics, an unlabelled command) at the
+newest session time received so far (the newest loop stamp, or ``/clock`` through
+``observe_clock`` where no loop topic is recorded; 0 before the first). ``receive`` is the
+wall-clock receive time (ns), as ``ros2 bag record`` logs without it. Parameter snapshots go on
+``/parameter_events``. What was written becomes complete records on disk whenever a topic's
+newest stamp is ``DURABLE_NS`` of session time past the last time (and at least that often on
+the monotonic clock), so a killed recorder loses at most that much of what it wrote. A topic's
+connection is added at its first message (or at the close), with the QoS its publishers offer
+then (``offered``). Closing writes the counts into the metadata (custom data
+``haptic_dob.recorder``). Why: docs/recording-and-analysis.md, "Recording sessions".
 """
 
 from __future__ import annotations

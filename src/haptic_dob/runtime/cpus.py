@@ -7,7 +7,8 @@ hand-over, and each move costs the process its warm caches. Pinning the device a
 the other keeps every process on warm caches (BENCHMARKS.md, "pinned", measures what it gains).
 As in ros2_control's controller
 manager (its ``cpu_affinity`` parameter), pinning is asked for, never the default: a pinned process
-cannot move away from a core that other work occupies.
+cannot move away from a core that other work occupies. ``scheduling`` says how the process is
+scheduled.
 """
 
 from __future__ import annotations
@@ -120,3 +121,10 @@ def workers_for(processes_per_job: int, free: float | None = None) -> int:
     """Jobs to run at once so that each of their busy processes has a free CPU (at least one)."""
     free = free_cpus() if free is None else free
     return max(1, int((free + 0.25) // processes_per_job))
+
+
+def scheduling() -> str:
+    """This process's CPU scheduling: ``SCHED_FIFO priority 50`` or ``normal``."""
+    if hasattr(os, "sched_getscheduler") and os.sched_getscheduler(0) == os.SCHED_FIFO:
+        return f"SCHED_FIFO priority {os.sched_getparam(0).sched_priority}"
+    return "normal"

@@ -1,17 +1,19 @@
 """Declarative parameters: one table per settings dataclass, used by nodes, YAML and batch runs.
 
-A settings dataclass marks each field with ``param(...)`` metadata (description, unit, range,
-choices, read-only). ``specs_of`` turns the fields into ``ParamSpec`` rows; nodes declare them
-as ROS 2 parameters with descriptors (``haptic_dob.runtime.ros.params``), and ``build`` turns a
-mapping of parameter values (a node's parameters or a ``ros__parameters`` YAML section) back into
-the dataclass, so a node and a batch run read the same names, defaults and limits.
+A settings dataclass marks each field with keyword-only ``param(...)`` metadata (a one-line
+description, unit, bounds, choices, read-only; details for the docs only). ``specs_of`` turns the
+fields into ``ParamSpec`` rows, the only way rows are made; nodes declare them as ROS 2
+parameters with descriptors (``haptic_dob.runtime.ros.params``), and ``build`` turns a mapping of
+parameter values (a node's parameters or a ``ros__parameters`` YAML section) back into the
+dataclass, so a node and a batch run read the same names, defaults and limits.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping
+import typing
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from enum import Enum
 from typing import Any, TypeVar
@@ -35,6 +37,7 @@ class ParamSpec:
     read_only: bool = False
     length: int | None = None  # arrays: the required number of elements, None = any
     items: type | None = None  # arrays: element type (float, int, str); None = the default's
+    details: str = ""  # longer text for the generated docs only (not the ROS descriptor)
 
     @property
     def item_kind(self) -> type | None:
@@ -117,37 +120,58 @@ class ParamSpec:
 
 
 def param(
+    *,
     description: str,
     unit: str = "",
-    min: float | None = None,
-    max: float | None = None,
-    choices: tuple[str, ...] = (),
+    bounds: tuple[float | None, float | None] | None = None,
+    choices: Sequence[str] = (),
     read_only: bool = False,
+    details: str = "",
 ) -> dict[str, Any]:
-    """Field metadata of a settings dataclass (``field(default=1.0, metadata=param(...))``)."""
+    """Field metadata of a settings dataclass (``field(default=1.0, metadata=param(...))``).
+
+    ``description``: one line, what the value is (the unit goes to ``unit``); ``bounds``: the
+    closed range (lo, hi), either side None for none; ``details``: longer text that only the
+    generated docs/parameters.md shows, not the ROS descriptor.
+    """
+    lo, hi = bounds if bounds is not None else (None, None)
     return {
         "param": {
             "description": description,
             "unit": unit,
-            "min": min,
-            "max": max,
+            "min": lo,
+            "max": hi,
             "choices": tuple(choices),
             "read_only": read_only,
+            "details": details,
         }
     }
 
 
-def specs_of(cls: type, prefix: str = "", read_only: bool | None = None) -> list[ParamSpec]:
+def specs_of(
+    cls: type,
+    prefix: str = "",
+    *,
+    read_only: bool | None = None,
+    defaults: Mapping[str, Any] | None = None,
+    about: str = "",
+) -> list[ParamSpec]:
     """The ``ParamSpec`` rows of a settings dataclass's annotated fields, names prefixed.
 
-    ``read_only`` overrides every field's own flag when given (structural groups).
+    ``read_only`` overrides every field's own flag when given (structural groups); ``defaults``
+    overrides the default of the fields it names (unprefixed: one group, a node's own default);
+    ``about`` heads every description (``"about: description"``: a group used for another
+    thing). An empty array's element type is its annotation's (``list[int]``).
     """
+    overrides = dict(defaults or {})
     out = []
     for f in dataclasses.fields(cls):
         meta = f.metadata.get("param")
         if meta is None:
             continue
-        if f.default is not dataclasses.MISSING:
+        if f.name in overrides:
+            default = overrides.pop(f.name)
+        elif f.default is not dataclasses.MISSING:
             default = f.default
         elif f.default_factory is not dataclasses.MISSING:
             default = f.default_factory()
@@ -158,20 +182,36 @@ def specs_of(cls: type, prefix: str = "", read_only: bool | None = None) -> list
             default, length = list(default), len(default)
         elif isinstance(default, Enum):
             default = default.value
+        items = _item_type(cls, f.name) if isinstance(default, list) and not default else None
         out.append(
             ParamSpec(
                 name=prefix + f.name,
                 default=default,
-                description=meta["description"],
+                description=f"{about}: {meta['description']}" if about else meta["description"],
                 unit=meta["unit"],
                 min=meta["min"],
                 max=meta["max"],
                 choices=meta["choices"],
                 read_only=meta["read_only"] if read_only is None else read_only,
                 length=length,
+                items=items,
+                details=meta["details"],
             )
         )
+    if overrides:
+        raise TypeError(f"{cls.__name__} has no parameter {', '.join(overrides)}")
     return out
+
+
+def _item_type(cls: type, name: str) -> type | None:
+    """The element type of array field ``name`` by its annotation (``list[int]``): int or str,
+    None for float (the default's)."""
+    hint = typing.get_type_hints(cls)[name]
+    for arg in typing.get_args(hint) or (hint,):  # a union of list[X] and tuple[X, ...]
+        items = typing.get_args(arg)
+        if items and items[0] in (int, str):
+            return items[0]  # type: ignore[no-any-return]  # int or str
+    return None
 
 
 def build(cls: type[T], values: Mapping[str, Any], prefix: str = "") -> T:

@@ -4,21 +4,14 @@ each cycle from their own sample and the newest message of the other side.
 ``MasterEnd.cycle``: the master's point and velocity of sample k -> the force the master renders
 (its controller's wall force ``F_w``) and the message to the slave. ``SlaveEnd.cycle``: the
 slave's point, velocity and contact force (estimated or measured) of sample k -> the point the
-slave tracks and the message to the master. Messages (``PortMessage``) carry slave units (the
-slave's base frame, m, m/s, N) and the energy that came into the channel at the sender's port;
-each end hands the other's messages to its ``DelayLine`` (``receive``), so only messages of
-earlier samples are ever used and the two ends may run in any order, in one process or two.
-
-Both ends book their port's energy and, with ``channel.passivity``, enforce it
-(``haptic_dob.teleop.passivity``). The master's port: flow the master's velocity, effort the
-force it renders (scaled to slave units). The slave's port: flow the velocity of the point it is
-told to track, effort the slave's contact force. When its peer is silent for ``timeout_s`` a side
-stops using it: the master renders zero force, the slave holds the point where it is. When
-messages come again the slave goes on from the held point (the master's motion during the
-silence is not replayed) and the master's force comes back over ``timeout_s`` (a linear ramp).
-Passivity control is for ``position_force``: under ``position_position`` the two ports' efforts
-(the master's coupling force, the slave's contact force) are not one port's, so both ends
-refuse it.
+slave tracks and the message to the master. Messages (``PortMessage``) carry slave units (base
+frame, m, m/s, N) and the energy that came in at the sender's port; each end puts the other's
+through its ``DelayLine`` (``receive``), so only earlier samples' messages are used and the ends
+may run in any order. Each end books its port's energy (master: its velocity and the force it
+renders; slave: the tracked point's velocity and the contact force) and, with
+``channel.passivity``, enforces it (refused under ``position_position``). A peer silent for
+``timeout_s``: the master renders zero, the slave holds its point; then the slave goes on from
+there and the master's force ramps back over ``timeout_s``. docs/design/teleoperation.md.
 """
 
 from __future__ import annotations

@@ -65,13 +65,18 @@ def node_values(sections: Mapping[str, Mapping[str, Any]], ns: str, node: str) -
 
 
 def load_teleop_sections(path: str | Path) -> dict[str, dict[str, Any]]:
-    """The YAML's sections, a relative ``urdf_path`` taken from the YAML's own directory (the
-    installed ``teleop_sim.yaml`` names ``urdf/arm7.urdf`` beside it)."""
+    """The YAML's sections, a relative ``urdf_path`` or ``slave.trajectory_path`` taken from the
+    YAML's own directory (the installed ``teleop_sim.yaml`` names ``urdf/arm7.urdf`` beside it)."""
     from haptic_dob.runtime.configs import urdf_beside
     from haptic_dob.runtime.params import load_sections
 
     sections = load_sections(path)
     urdf_beside(sections, path)
+    here = Path(path).resolve().parent
+    for values in sections.values():
+        given = values.get("slave.trajectory_path")
+        if isinstance(given, str) and given and not Path(given).is_absolute():
+            values["slave.trajectory_path"] = str(here / given)
     return sections
 
 

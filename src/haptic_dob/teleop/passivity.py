@@ -1,21 +1,15 @@
 """Time-domain passivity of one port of a delayed channel (Hannaford & Ryu 2002; for delay, the
 time-delay power network of Ryu, Artigas & Preusche 2010).
 
-Each end of the channel books the energy at its own port every sample, split by the sign of the
-power ``y`` the channel delivers there: ``E_out += y T`` while ``y > 0``, ``E_in -= y T`` while
-``y < 0``. Its ``E_in`` travels to the other end with the messages. The channel is passive when
-neither end gives out more than came in at the other: ``E_out(k) <= E_in,remote(k - delay)``.
-Both sums only grow, so the newest value received is a safe bound whatever the delay, the jitter
-or the losses (a lost message only delays the bound).
-
-The passivity controller enforces it sample by sample. At the master's end (impedance causality:
-velocity in, force out) a damper ``F - alpha v``; at the slave's end (admittance causality: force
-in, velocity out) ``v + beta F``. Each is set so that the output energy of the sample just meets
-the bound: never more than the original force (or velocity) along the other variable, so the
-correction has no spike at small velocities (forces). The power of one sample is booked with the
-sample's output and the sample's input, the discrete observer of Hannaford & Ryu.
-
-Values are 3-vectors of floats (slave units: N, m/s); nothing here allocates arrays.
+Each end books the energy at its own port every sample, split by the sign of the power ``y`` the
+channel delivers there: ``E_out += y T`` while ``y > 0``, ``E_in -= y T`` while ``y < 0``; its
+``E_in`` travels to the other end with the messages. Passive: ``E_out(k) <= E_in,remote(k -
+delay)``, checked against the newest ``E_in,remote`` received. The controller enforces it each
+sample: at the master's end (velocity in, force out) a damper ``F - alpha v``, at the slave's
+(force in, velocity out) ``v + beta F``, each just enough that the sample's output energy meets
+the bound, and never more than the original force (or velocity) along the other variable. A
+sample's power is booked with the sample's output and input. Values are 3-vectors of floats
+(slave units: N, m/s); nothing here allocates arrays. Why: docs/design/teleoperation.md.
 """
 
 from __future__ import annotations

@@ -3,17 +3,13 @@ and the channel between master and slave (``ChannelSettings``).
 
 Frames and units: the slave's base frame carries the channel's quantities. The master's
 displacement ``d_m`` from its start point maps to the slave's as ``position_scale * R d_m``; a
-force ``F`` of the slave's side reaches the master as ``force_scale * R^T F``. ``R`` is a
+force ``F`` of the slave's side reaches the master as ``force_scale * R^T F``; ``R`` is a
 rotation (row-major 3x3 ``rotation``); for a 1-DOF master (the slide) only its axis's column
-matters and the rendered force is taken along the axis.
-
-Architectures:
-
-- ``position_force``: the slave tracks the master's (delayed) position; the master renders the
-  slave's contact force, from the slave's observer (``force_source: estimate``, no sensor) or
-  from a wrist force sensor (``sensor``);
-- ``position_position``: both track each other's delayed position; the master renders a coupling
-  spring-damper ``K (x_s - x_m) + B (v_s - v_m)`` (slave units) to the slave's delayed position.
+matters and the rendered force is taken along the axis. Architectures: ``position_force``, the
+slave tracks the master's (delayed) position and the master renders the slave's contact force,
+from the slave's observer (``force_source: estimate``) or a wrist sensor (``sensor``);
+``position_position``, both track each other's delayed position and the master renders a
+coupling spring-damper ``K (x_s - x_m) + B (v_s - v_m)`` (slave units).
 """
 
 from __future__ import annotations
@@ -37,46 +33,58 @@ class TeleopSettings:
 
     architecture: str = field(
         default="position_force",
-        metadata=param("what the master renders", choices=ARCHITECTURES, read_only=True),
+        metadata=param(
+            description="what the master renders", choices=ARCHITECTURES, read_only=True
+        ),
     )
     force_source: str = field(
         default="estimate",
         metadata=param(
-            "position_force: the slave force sent back, the observer's estimate or the wrist "
-            "sensor's reading",
+            description=(
+                "position_force: the slave force sent back (observer's or wrist sensor's)"
+            ),
             choices=FORCE_SOURCES,
+            details=("estimate: the observer's estimate; sensor: the wrist sensor's reading."),
         ),
     )
     rotation: tuple[float, ...] = field(
         default=IDENTITY,
-        metadata=param("rotation from the master's frame to the slave's (row-major 3x3)"),
+        metadata=param(
+            description="rotation from the master's frame to the slave's (row-major 3x3)"
+        ),
     )
     position_scale: float = field(
-        default=1.0, metadata=param("slave displacement per master displacement", "", 1e-3, 1e3)
+        default=1.0,
+        metadata=param(
+            description="slave displacement per master displacement", bounds=(1e-3, 1e3)
+        ),
     )
     force_scale: float = field(
-        default=1.0, metadata=param("master force per slave force", "", 0.0, 1e3)
+        default=1.0, metadata=param(description="master force per slave force", bounds=(0.0, 1e3))
     )
     master_max_force_n: float = field(
         default=4.0,
         metadata=param(
-            "the largest force the master renders (its controller's max_force_n, master "
-            "units): the channel books no more than it renders",
-            "N",
-            1e-3,
-            1e4,
+            description=("the largest force the master renders (its controller's max_force_n)"),
+            unit="N",
+            bounds=(1e-3, 1e4),
+            details=("In master units: the channel books no more than the master renders."),
         ),
     )
     coupling_n_per_m: float = field(
         default=1000.0,
         metadata=param(
-            "position_position: the master's coupling stiffness (slave units)", "N/m", 0.0, 1e6
+            description="position_position: the master's coupling stiffness (slave units)",
+            unit="N/m",
+            bounds=(0.0, 1e6),
         ),
     )
     coupling_n_s_per_m: float = field(
         default=20.0,
         metadata=param(
-            "position_position: the master's coupling damping (slave units)", "N s/m", 0.0, 1e4
+            description="position_position: the master's coupling damping (slave units)",
+            unit="N s/m",
+            bounds=(0.0, 1e4),
         ),
     )
 
@@ -123,38 +131,52 @@ class ChannelSettings:
     round_trip_delay_ms: float = field(
         default=2.0,
         metadata=param(
-            "round-trip delay; each way half of it, at least one sample",
-            "ms",
-            0.0,
-            1e4,
+            description="round-trip delay; each way half of it, at least one sample",
+            unit="ms",
+            bounds=(0.0, 1e4),
             read_only=True,
         ),
     )
     jitter_ms: float = field(
         default=0.0,
         metadata=param(
-            "largest extra one-way delay, uniform per message", "ms", 0.0, 1e3, read_only=True
+            description="largest extra one-way delay, uniform per message",
+            unit="ms",
+            bounds=(0.0, 1e3),
+            read_only=True,
         ),
     )
     loss: float = field(
         default=0.0,
-        metadata=param("probability that a message is lost", "", 0.0, 0.99, read_only=True),
+        metadata=param(
+            description="probability that a message is lost", bounds=(0.0, 0.99), read_only=True
+        ),
     )
     seed: int = field(
-        default=0, metadata=param("seed of jitter and loss", "", 0, 2**31 - 1, read_only=True)
+        default=0,
+        metadata=param(
+            description="seed of jitter and loss", bounds=(0, 2**31 - 1), read_only=True
+        ),
     )
     cut_at_s: float = field(
         default=0.0,
         metadata=param(
-            "the link dies at this sample time, both ways (0: never)", "s", 0.0, 1e7, read_only=True
+            description="the link dies at this sample time, both ways (0: never)",
+            unit="s",
+            bounds=(0.0, 1e7),
+            read_only=True,
         ),
     )
     timeout_s: float = field(
         default=0.02,
-        metadata=param("a peer silent this long (sample time) counts as lost", "s", 1e-3, 10.0),
+        metadata=param(
+            description="a peer silent this long (sample time) counts as lost",
+            unit="s",
+            bounds=(1e-3, 10.0),
+        ),
     )
     passivity: bool = field(
-        default=False, metadata=param("time-domain passivity control on both ports")
+        default=False, metadata=param(description="time-domain passivity control on both ports")
     )
 
     def __post_init__(self) -> None:

@@ -4,20 +4,15 @@ Per cycle, with the joint state of sample k and the point ``x_d`` to track (m, b
 
 1. one damped-least-squares step of differential inverse kinematics moves the joint target
    ``q_d`` toward ``x_d``: ``dq = J# (x_d - p(q_d)) + (I - J# J) k_n (q_0 - q_d)``,
-   ``J# = J^T (J J^T + lambda^2 I)^-1`` at ``q_d``, the second term pulling the redundant joints
-   toward the start posture ``q_0`` in the null space; ``dq`` is limited to
-   ``max_joint_speed_rad_s`` per period;
-2. ``tau = K (q_d - q) - B q' + G(q)`` (gravity of the controller's model), saturated per joint
-   at the model's effort limits (``haptic_dob.core.control.saturate``).
+   ``J# = J^T (J J^T + lambda^2 I)^-1`` at ``q_d`` (the null-space term pulls toward the start
+   posture ``q_0``), ``dq`` limited to ``max_joint_speed_rad_s`` per period;
+2. ``tau = K (q_d - q) - B q' + G(q)`` (the controller's model's gravity), saturated per joint at
+   the model's effort limits (``haptic_dob.core.control.saturate``).
 
-The gains are matrices shaped by the inertia at the start pose: ``K = D(q_0) w^2``,
-``B = 2 zeta w D(q_0)`` with ``w = 2 pi bandwidth_hz``, so every mode of the arm (not only
-every joint) is a second-order loop of that bandwidth: diagonal gains ``D_ii w^2`` leave modes of
-joints with parallel axes turning against each other (little inertia, the sum of their gains)
-far above the bandwidth, where the 1 kHz loop chatters at 500 Hz. Per-joint gains, when given,
-are diagonal.
-``q_d`` and ``q_0`` start at the first sample's joint positions. In contact the target runs into
-the wall while the arm stops at it; the joints' springs push with the difference.
+Gains: ``K = D(q_0) w^2``, ``B = 2 zeta w D(q_0)``, ``w = 2 pi bandwidth_hz`` (per-joint gains,
+when given, are diagonal); ``q_d``, ``q_0`` start at the first sample's positions. With
+``trajectory_path`` (an excitation file) it plays that by computed torque instead (``play``).
+Why full matrices, the target in contact, the playing law: docs/design/teleoperation.md.
 """
 
 from __future__ import annotations
@@ -30,7 +25,11 @@ import numpy as np
 from haptic_dob.core.control import saturate
 from haptic_dob.core.models.base import DeviceModel, Vec
 from haptic_dob.core.validation import nonnegative, positive
+from haptic_dob.identification.arm_excitation import FourierExcitation
 from haptic_dob.runtime.params import param
+
+#: how long the difference between the arm's first posture and a trajectory's start fades (s)
+BLEND_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -40,39 +39,58 @@ class SlaveImpedance:
     bandwidth_hz: float = field(
         default=8.0,
         metadata=param(
-            "each joint's loop bandwidth on its own inertia at the start pose", "Hz", 0.1, 200.0
+            description="each joint's loop bandwidth on its own inertia at the start pose",
+            unit="Hz",
+            bounds=(0.1, 200.0),
         ),
     )
     damping_ratio: float = field(
-        default=1.0, metadata=param("each joint's damping ratio", "", 0.0, 10.0)
+        default=1.0, metadata=param(description="each joint's damping ratio", bounds=(0.0, 10.0))
     )
     stiffness_n_m_per_rad: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "joint stiffness K, one per joint; [] = from bandwidth_hz", "N m/rad", 0.0, 1e6
+            description="joint stiffness K, one per joint; [] = from bandwidth_hz",
+            unit="N m/rad",
+            bounds=(0.0, 1e6),
         ),
     )
     damping_n_m_s_per_rad: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "joint damping B, one per joint; [] = from damping_ratio", "N m s/rad", 0.0, 1e5
+            description="joint damping B, one per joint; [] = from damping_ratio",
+            unit="N m s/rad",
+            bounds=(0.0, 1e5),
         ),
     )
     ik_damping_m: float = field(
-        default=0.01, metadata=param("damping lambda of the IK's least squares", "m", 1e-6, 1.0)
+        default=0.01,
+        metadata=param(
+            description="damping lambda of the IK's least squares", unit="m", bounds=(1e-6, 1.0)
+        ),
     )
     posture_gain: float = field(
         default=0.01,
         metadata=param(
-            "per-period pull of the redundant joints toward the start posture", "", 0.0, 1.0
+            description="per-period pull of the redundant joints toward the start posture",
+            bounds=(0.0, 1.0),
         ),
     )
     max_joint_speed_rad_s: float = field(
         default=2.0,
-        metadata=param("largest speed of the joint target", "rad/s", 1e-3, 100.0),
+        metadata=param(
+            description="largest speed of the joint target", unit="rad/s", bounds=(1e-3, 100.0)
+        ),
     )
     gravity_compensation: bool = field(
-        default=True, metadata=param("add the model's gravity effort")
+        default=True, metadata=param(description="add the model's gravity effort")
+    )
+    trajectory_path: str = field(
+        default="",
+        metadata=param(
+            description="excitation trajectory file to play; '' = track pose_desired",
+            details="Joint targets by time, as haptic-excite writes them.",
+        ),
     )
 
     def __post_init__(self) -> None:
@@ -94,9 +112,16 @@ class SlaveController:
         model: the slave's model (its kinematics, inertia at the start pose, gravity, limits).
         settings: gains and IK settings.
         dt: the control period (s).
+        trajectory: a trajectory to play (default: ``settings.trajectory_path``'s, if any).
     """
 
-    def __init__(self, model: DeviceModel, settings: SlaveImpedance, dt: float) -> None:
+    def __init__(
+        self,
+        model: DeviceModel,
+        settings: SlaveImpedance,
+        dt: float,
+        trajectory: FourierExcitation | None = None,
+    ) -> None:
         self.model = model
         self.settings = settings
         self.dt = positive("dt", dt)
@@ -116,6 +141,14 @@ class SlaveController:
         self.q_0: Vec = np.zeros(n)  # the posture the redundant joints return to
         self.K = np.zeros((n, n))  # joint stiffness (N m/rad)
         self.B = np.zeros((n, n))  # joint damping (N m s/rad)
+        self.trajectory = trajectory
+        if trajectory is None and settings.trajectory_path:
+            self.trajectory = FourierExcitation.load(settings.trajectory_path)
+        if self.trajectory is not None and self.trajectory.joints != tuple(model.joint_names):
+            raise ValueError(
+                f"slave.trajectory_path: the trajectory moves {list(self.trajectory.joints)}, "
+                f"the model's joints are {list(model.joint_names)}"
+            )
 
     def start(self, q: Vec) -> None:
         """Take ``q`` as the joint target, the posture and the pose the gains are set at."""
@@ -151,11 +184,34 @@ class SlaveController:
         self.q_d = q_d
         return self.joint_command(q, qd, q_d)
 
-    def joint_command(self, q: Vec, qd: Vec, q_d: Vec) -> list[float]:
-        """``K (q_d - q) - B q' + G(q)``, saturated (N m or N): the impedance around ``q_d``."""
+    def play(self, q: Vec, qd: Vec, t_s: float) -> list[float]:
+        """Joint efforts (N m or N) playing the trajectory at ``t_s`` (s since the first sample)."""
+        traj = self.trajectory
+        if traj is None:
+            raise ValueError("no trajectory to play (slave.trajectory_path is '')")
         if self.q_d is None:
             self.start(q)
-        tau = self.K @ (q_d - q) - self.B @ qd
+        (q_d,), (v_d,), (a_d,) = traj.motion(np.array([t_s]))
+        if t_s < BLEND_S:
+            gap = self.q_0 - np.asarray(traj.start)
+            phase = math.pi * t_s / BLEND_S
+            w = math.pi / BLEND_S
+            q_d = q_d + (0.5 + 0.5 * math.cos(phase)) * gap
+            v_d = v_d - 0.5 * w * math.sin(phase) * gap
+            a_d = a_d - 0.5 * w * w * math.cos(phase) * gap
+        s = self.settings
+        w = 2.0 * math.pi * s.bandwidth_hz
+        D, h = self.model._mass_matrix(q), self.model._bias_effort(q, qd)
+        tau = D @ (a_d + w * w * (q_d - q) + 2.0 * s.damping_ratio * w * (v_d - qd)) + h
+        out: list[float] = tau.tolist()
+        return out if self.limits is None else saturate(out, self.limits)
+
+    def joint_command(self, q: Vec, qd: Vec, q_d: Vec, qd_d: Vec | None = None) -> list[float]:
+        """``K (q_d - q) + B (q_d' - q') + G(q)``, saturated (N m or N): the impedance around
+        ``q_d`` (``q_d'`` = 0 when not given)."""
+        if self.q_d is None:
+            self.start(q)
+        tau = self.K @ (q_d - q) - self.B @ (qd if qd_d is None else qd - qd_d)
         if self.settings.gravity_compensation:
             tau += self.model._gravity(q)
         out: list[float] = tau.tolist()

@@ -1,19 +1,15 @@
 """Publishers and subscriptions of the loop's topics: in process first, DDS for everyone else.
 
 ``LoopPublisher.publish(value)`` hands the value to the subscribers in this process at once
-(``haptic_msgs_py.bus``) and sends it on DDS after the command. In a process that hosts several
-nodes (composed), a topic goes on DDS only while a reader elsewhere is matched: the count follows
-the publisher's matched events, and a lockstep device waits for every publisher of its process to
-have matched the readers the graph shows before sample 0 (a reader that matches while the loop
-runs gets the samples from when this process has seen the match, a few milliseconds later). A
-node alone in its process sends always, as any ROS 2 publisher does, except ``on_demand`` topics
-(evaluation only), sent while a reader is matched. ``LoopSubscription`` takes values from
-publishers in this process and opens a DDS subscription only while the topic has none here, so a
-composed node never also receives its neighbour's message over DDS (unless asked to listen to
-other processes as well, ``listen_outside``: then its values from DDS, the middleware's copies of
-its neighbour's among them, go to a callback of their own). Every node keeps its
+(``haptic_msgs_py.bus``) and sends it on DDS after the command. In a composed process a topic
+goes on DDS only while a reader elsewhere is matched (the count follows the publisher's matched
+events; a lockstep device waits before sample 0 until every publisher of its process matched the
+readers the graph shows); a node alone in its process sends always, but ``on_demand`` topics
+(evaluation only) only while a reader is matched. ``LoopSubscription`` takes values from
+publishers in this process and opens a DDS subscription only while the topic has none here
+(``listen_outside``: values from DDS too, to a callback of their own). Every node keeps its
 ordinary rclpy publishers, so ``ros2 topic list``/``info``/``echo`` see the same graph whether
-nodes share a process or not.
+nodes share a process or not. Why: docs/design/timing.md.
 """
 
 from __future__ import annotations

@@ -1,27 +1,16 @@
 """QoS profiles of the haptic loop.
 
-Loop publishers are reliable and volatile and keep the last 2000 samples: a reliable reader that
-falls behind (a recorder on a loaded machine) is repaired from that history, by up to 2000
-samples (2 s at 1 kHz), and a reader that joins late (``ros2 topic echo``, a plot, RViz) sees the
-live stream at once, not a replay. A reader gets only what is sent after it has matched the
-writer, and it can match some time after the writer matched it; so a reader that must have every
-sample from the first (the recorder) is matched on both sides before sample 0: the device waits
-for its writers to match every subscriber the graph shows, and for every recorder to report that
-its readers have matched (``recorder/progress``, ``PROGRESS_NOT_MATCHED_NS`` until then).
-
-The loop's own subscriptions (``loop_input``, a node's ``input_reliability``) have a deep queue.
-The command input (the device's ``effort_command``) is reliable by default: a person's one-off
-message (``ros2 topic pub --once``) arrives even when it was sent before the reader had matched
-the new writer, which a best-effort reader drops. The sensor streams (the environment's and the
-controller's inputs) are best effort by default, as ROS 2's sensor-data profile: no
-acknowledgements, so nodes in separate processes cycle faster (BENCHMARKS.md measures both); a
-sample lost on the critical path of a lockstep run stalls it until the device re-sends the sample
-after ``lockstep_timeout_s`` (every node answers a repeated sample idempotently, so the run stays
-exact). Nodes sharing a process hand the loop's values over in process either way. The
-observer's input is always reliable (``ESTIMATOR_IN``): off the critical path in OL and CL it may
-lag on a loaded machine, and a sample lost there would be a permanent gap in the recorded
-estimate; reliable delivery repairs it from the publisher's history. The observer counts gaps in
-the samples it receives.
+Loop publishers: reliable, volatile, keep last 2000 (a reader that falls behind is repaired by
+up to 2000 samples, 2 s at 1 kHz; a late reader sees the live stream, not a replay). A reader
+that must have every sample from the first (the recorder) is matched on both sides before
+sample 0: the device waits for its writers to match every subscriber the graph shows, and for
+every recorder to report its readers matched (``recorder/progress``, ``PROGRESS_NOT_MATCHED_NS``
+until then). The loop's subscriptions (``loop_input``, a node's ``input_reliability``) have a
+deep queue: the command input (the device's ``effort_command``) reliable by default, the sensor
+streams (the environment's and the controller's inputs) best effort by default (a sample lost
+on a lockstep run's path is sent again after ``lockstep_timeout_s``), the observer's input
+always reliable (``ESTIMATOR_IN``). Nodes sharing a process hand values over in process either
+way. Why each: docs/running.md, "Topics"; docs/design/timing.md.
 """
 
 from __future__ import annotations

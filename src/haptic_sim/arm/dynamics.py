@@ -86,7 +86,8 @@ def coulomb_smoothing(
     if speed is not None and np.any(np.asarray(speed) > 0.0):
         raise ValueError(
             "a simulated arm smooths its Coulomb friction over its physics step: "
-            "urdf.coulomb_speed_rad_per_s is for an observer's model, leave it [] here"
+            "a Coulomb turn (urdf.coulomb_speed_rad_per_s, or the URDF's haptic_dob:dynamics "
+            "coulomb_speed) is for an observer's model: set urdf.coulomb_speed_rad_per_s to [0.0]"
         )
     fc = getattr(model, "coulomb", None)
     if fc is None or not np.any(np.asarray(fc) > 0.0):

@@ -29,40 +29,56 @@ class ArmDeviceParams:
     max_force_n: float = field(
         default=PHANTOM_15_PEAK_FORCE_N,
         metadata=param(
-            "tip force the joint limits are derived from (PHANToM 1.5 peak)", "N", 1e-3, 1e4
+            description="tip force the joint limits are derived from (PHANToM 1.5 peak)",
+            unit="N",
+            bounds=(1e-3, 1e4),
         ),
     )
     joint_effort_limits: list[float] | tuple[float, ...] = field(
         default_factory=list,
-        metadata=param("per-joint effort limits; [] = from the model or max_force_n", "N m"),
+        metadata=param(
+            description="per-joint effort limits; [] = from the model or max_force_n", unit="N m"
+        ),
     )
     encoder_resolution_rad: float = field(
         default=PHANTOM_15_ENCODER_RAD,
-        metadata=param("joint encoder resolution; 0 = ideal", "rad", 0.0, 0.1),
+        metadata=param(
+            description="joint encoder resolution; 0 = ideal", unit="rad", bounds=(0.0, 0.1)
+        ),
     )
     initial_position: list[float] | tuple[float, ...] = field(
         default_factory=list,
-        metadata=param("joint angles at start; [] = the model's home (PHANToM) or zeros", "rad"),
+        metadata=param(
+            description="joint angles at start; [] = the model's home (PHANToM) or zeros",
+            unit="rad",
+        ),
     )
     hand_direction: tuple[float, float, float] = field(
         default=(0.0, 0.0, -1.0),
-        metadata=param("direction of the hand's push (unit 3-vector, base frame)"),
+        metadata=param(description="direction of the hand's push (unit 3-vector, base frame)"),
     )
     hand_lateral_amplitude_m: float = field(
         default=0.0,
-        metadata=param("std of the semi-random hand motion across the push", "m", 0.0, 1.0),
+        metadata=param(
+            description="std of the semi-random hand motion across the push",
+            unit="m",
+            bounds=(0.0, 1.0),
+        ),
     )
     external_force_n: tuple[float, float, float] = field(
         default=(0.0, 0.0, 0.0),
-        metadata=param("known external force on the end effector (x, y, z)", "N"),
+        metadata=param(description="known external force on the end effector (x, y, z)", unit="N"),
     )
     external_force_at_s: float = field(
-        default=0.0, metadata=param("time the external force steps on", "s", 0.0, 1e6)
+        default=0.0,
+        metadata=param(description="time the external force steps on", unit="s", bounds=(0.0, 1e6)),
     )
     velocity: str = field(
         default="difference",
         metadata=param(
-            "joint velocity reported: backward difference of the encoders, or the exact one",
+            description=(
+                "joint velocity reported: backward difference of the encoders, or the exact one"
+            ),
             choices=VELOCITY_SOURCES,
         ),
     )

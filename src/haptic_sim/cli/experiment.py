@@ -19,7 +19,7 @@ one each); a run whose bag is complete is not run again, so an interrupted exper
 (``--fresh`` starts over). The
 bags are analysed as ``haptic-analyze`` does (``runs/*/analysis.json``), and ``report.md`` with
 its figures and ``results.json`` is written to ``--out``. ``--quick`` runs only OL, CL Kf=2 and
-DOB Kf=1 at 800 N/m for 20 s (the demo).
+DOB Kf=1 at 800 N/m for 40 s (the demo).
 """
 
 from __future__ import annotations

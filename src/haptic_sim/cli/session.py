@@ -16,7 +16,6 @@ from haptic_dob.runtime.configs import resolve_config
 from haptic_dob.runtime.params import load_node_params, node_view
 from haptic_sim.arm.session import ArmSessionConfig, ArmSessionSummary, run_arm_session
 from haptic_sim.device.batch import BatchSummary, load_session, run_batch, summarize
-from haptic_sim.hand import reference_for_force
 from haptic_sim.slide.session import SessionConfig, SessionSummary, run_session
 from haptic_sim.slide.stability import law_for
 
@@ -51,9 +50,6 @@ def command(
         k = positive("--stiffness", stiffness)
         w = cfg.wall
         cfg = cfg.replace(wall=VirtualWall(k, w.damping_n_s_per_m, w.position, w.normal))
-        if cfg.hand.behaviour == "semi_random":
-            offset, amplitude = reference_for_force(k, cfg.hand.stiffness_n_per_m)
-            cfg = cfg.replace(hand__offset_m=offset, hand__amplitude_m=amplitude)
     if duration is not None:
         cfg = cfg.replace(loop__duration_s=positive("--duration", duration))
     if seed is not None:
@@ -170,7 +166,7 @@ def main(argv: list[str] | None = None) -> int:
         "--stiffness",
         type=float,
         metavar="N_PER_M",
-        help="override the wall stiffness (and adapt the semi-random hand's push)",
+        help="override the wall stiffness (the hand pushes to the same depth)",
     )
     p.add_argument("--duration", type=float, metavar="S", help="override the length in seconds")
     p.add_argument("--seed", type=int, help="override the seed")

@@ -11,8 +11,9 @@ missed tick is a period the simulation loses). ``CycleStats`` is what a run repo
 
 from __future__ import annotations
 
+import json
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 from haptic_dob.runtime.latency import LatencyHistogram
 
@@ -32,6 +33,11 @@ class CycleStats:
     refused_commands: int
     limited_commands: int
     watchdog_trips: int
+
+    def write(self, path: str) -> None:
+        """Write these statistics to ``path`` as the ``stats_file`` JSON (NaN as ``NaN``)."""
+        with open(path, "w", encoding="utf-8") as fh:
+            json.dump(asdict(self), fh, indent=2)
 
 
 class RealtimeStats:

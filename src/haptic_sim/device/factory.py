@@ -13,7 +13,6 @@ serve both.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import replace
 from typing import Any
 
 from haptic_dob.core.environment import VirtualWall
@@ -29,21 +28,20 @@ from haptic_sim.slide.device import SimulatedSlide, SlideDeviceParams
 from haptic_sim.slide.session import LoopSettings
 
 #: an arm touches nothing unless ``contact.stiffness_n_per_m`` says so
-NO_CONTACT = {"contact.stiffness_n_per_m": 0.0}
+NO_WALL = {"stiffness_n_per_m": 0.0}
+NO_CONTACT = {f"contact.{name}": value for name, value in NO_WALL.items()}
 
 
 def contact_specs() -> list[ParamSpec]:
     """``contact.*``: the wall an arm touches (one-sided; zero stiffness: none)."""
-    return [
-        replace(
-            s,
-            description=f"arms, the wall the tip touches: {s.description}"
-            + ("; 0 = nothing to touch" if s.name in NO_CONTACT else ""),
-            default=NO_CONTACT.get(s.name, s.default),
-        )
-        for s in specs_of(VirtualWall, "contact.", read_only=True)
-        if s.name != "contact.two_sided"
-    ]
+    specs = specs_of(
+        VirtualWall,
+        "contact.",
+        read_only=True,
+        defaults=NO_WALL,
+        about="arm contact (K = 0: none)",
+    )
+    return [s for s in specs if s.name != "contact.two_sided"]
 
 
 def simulation_specs() -> list[ParamSpec]:

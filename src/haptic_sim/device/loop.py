@@ -1,22 +1,17 @@
 """The simulated device's cycle, ROS-free: when sample k goes out and which command moves the plant.
 
 - lockstep: sample 0 goes out once the graph is up (``LoopPort.waiting_for``) and settled; sample
-  k+1 only after command k arrived (labelled with sample k's stamp, or unlabelled). Without a
-  command for ``lockstep_timeout_s`` the loop says so and sends sample k again. While a recorder
-  lags (``RecorderGate``) command k is held; after the last sample the run ends once the recorder
-  has written it.
+  k+1 only after command k came (labelled with sample k's stamp, or unlabelled); without it for
+  ``lockstep_timeout_s`` the loop says so and sends sample k again. While a recorder lags
+  (``RecorderGate``) command k is held; the run ends once the recorder wrote the last sample.
 - realtime: ticks on the wall clock's grid (sample 0's time plus whole periods) once the graph is
-  up, applies the newest valid command and steps the plant one period; each sample is stamped
-  with the system clock when it is taken, as a hardware driver stamps. A tick that comes a period
-  or more late is an overrun, the grid points it passed are missed ticks (the simulation loses
-  them: catching up would cost a loaded machine more periods still), and the next tick is again
-  on the grid: time never slows, and a run of ``last_k`` periods ends ``last_k`` periods after
-  sample 0. The watchdog (``CommandWatchdog``) counts the samples the device sent and zeroes the
-  effort when commands stop; ``RealtimeStats`` counts whether command k came before the next
-  tick, and the overruns.
+  up, applies the newest valid command, steps the plant one period and stamps the sample with the
+  system clock. A tick a period or more late is an overrun and the grid points it passed are
+  missed ticks, lost (docs/running.md, "Clock modes"): a run of ``last_k`` periods ends
+  ``last_k`` periods after sample 0. ``CommandWatchdog`` counts the samples sent and zeroes the
+  effort when commands stop; ``RealtimeStats`` counts commands before the next tick, and overruns.
 
-Every command passes the ``CommandGuard`` first. The node behind ``LoopPort`` publishes, runs
-deferred work and answers questions about the ROS graph; the loop tells it what to do.
+Every command passes the ``CommandGuard`` first; ``LoopPort``, the node, does what the loop says.
 """
 
 from __future__ import annotations

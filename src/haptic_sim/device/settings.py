@@ -1,9 +1,9 @@
 """The device node's parameters: the rows it declares and the settings its loop reads of them.
 
 ``device_node_specs`` is the whole table (``docs/parameters.md`` lists it in this order):
-``safety_specs`` (the watchdog's timeout, the command guard's limits), the loop, input, command
+``DeviceSafety`` (the watchdog's timeout, the command guard's limits), the loop, input, command
 authority (who may command the device), process, model, clock and simulation rows, then
-``schedule_specs`` (lockstep re-sends, the start-up gate, recorder back-pressure, the statistics
+``DeviceSchedule`` (lockstep re-sends, the start-up gate, recorder back-pressure, the statistics
 file). ``DeviceLoopSettings`` is what the loop reads of them at run time (``missing_nodes``,
 which of ``wait_for`` the graph lacks, is the nodes' common helper).
 """
@@ -11,21 +11,22 @@ which of ``wait_for`` the graph lacks, is the nodes' common helper).
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from haptic_dob.core.models.factory import model_specs
-from haptic_dob.nodes.common import (
-    CLOCK_MODES,
-    command_authority_specs,
-    input_specs,
-    loop_specs,
-    process_specs,
+from haptic_dob.nodes.settings import (
+    RELIABLE_INPUTS,
+    CommandInputSettings,
+    LoopInputs,
+    LoopTiming,
+    ProcessSettings,
 )
-from haptic_dob.runtime.params import ParamSpec
+from haptic_dob.runtime.params import ParamSpec, param, specs_of
 from haptic_sim.device.factory import simulation_specs
 
 DEFAULT_WAIT_FOR = ["environment_node", "observer_node", "controller_node"]
+CLOCK_MODES = ("lockstep", "realtime")
 
 
 #: model parameters a simulated device does not take (its own physics are ``plant.*`` or
@@ -45,102 +46,127 @@ ASSUMED_ONLY = frozenset(
 def device_node_specs() -> list[ParamSpec]:
     """Every parameter of the device node."""
     return [
-        *safety_specs(),
-        *loop_specs(),
-        *input_specs("reliable"),
-        *command_authority_specs(),
-        *process_specs(),
+        *specs_of(DeviceSafety),
+        *specs_of(LoopTiming),
+        *specs_of(LoopInputs, defaults=RELIABLE_INPUTS),
+        *specs_of(CommandInputSettings),
+        *specs_of(ProcessSettings),
         # the slide's physics is plant.* (its truth), the point mass's cartesian.*; slide.* and
         # point_mass.* are the model the others assume
         *(s for s in model_specs() if s.name not in ASSUMED_ONLY),
-        ParamSpec(
-            "clock_mode",
-            "lockstep",
-            "lockstep: advance when command k arrived (stamps k * T); realtime: tick at rate_hz on "
-            "the wall clock (stamps: the system clock when each sample is taken)",
+        *specs_of(DeviceClock),
+        *simulation_specs(),
+        *specs_of(DeviceSchedule),
+    ]
+
+
+@dataclass(frozen=True)
+class DeviceSafety:
+    """The realtime watchdog's timeout and the per-joint effort limits."""
+
+    command_timeout_s: float = field(
+        default=0.005,
+        metadata=param(
+            description=("realtime watchdog: zero effort after this long without a valid command"),
+            unit="s",
+            bounds=(0.0005, 1.0),
+            details=(
+                "Counted in the samples the device sent: a stall of the device's own process does "
+                "not count."
+            ),
+        ),
+    )
+    effort_limits: list[float] | tuple[float, ...] = field(
+        default_factory=lambda: [0.0],
+        metadata=param(
+            description="per-joint effort limit (N or N m) on every command; [0.0] = saturation",
+            details=("At most the actuator's saturation; [0.0] = the actuator's saturation."),
+        ),
+    )
+
+
+@dataclass(frozen=True)
+class DeviceClock:
+    """Whether the device steps in lockstep or ticks in real time."""
+
+    clock_mode: str = field(
+        default="lockstep",
+        metadata=param(
+            description=("lockstep: step when command k arrived; realtime: tick on the wall clock"),
             choices=CLOCK_MODES,
             read_only=True,
+            details=(
+                "lockstep: sample k is stamped k * T. realtime: ticks at rate_hz on the wall "
+                "clock, each sample stamped with the system clock when it is taken."
+            ),
         ),
-        *simulation_specs(),
-        *schedule_specs(),
-    ]
+    )
 
 
-def safety_specs() -> list[ParamSpec]:
-    """The realtime watchdog's timeout and the per-joint effort limits."""
-    return [
-        ParamSpec(
-            "command_timeout_s",
-            0.005,
-            "realtime watchdog: zero effort when no valid command came for this long, counted in "
-            "the samples the device sent (a stall of the device's own process does not count)",
-            "s",
-            0.0005,
-            1.0,
-        ),
-        ParamSpec(
-            "effort_limits",
-            [0.0],
-            "per-joint effort limit (N or N m) applied to every command, at most the actuator's "
-            "saturation; [0.0] = the actuator's saturation",
-        ),
-    ]
-
-
-def schedule_specs() -> list[ParamSpec]:
+@dataclass(frozen=True)
+class DeviceSchedule:
     """Lockstep re-sends, the start-up gate, recorder back-pressure and the statistics file."""
-    return [
-        ParamSpec(
-            "lockstep_timeout_s",
-            2.0,
-            "lockstep: warn and re-send a sample after this long without its command (a "
-            "best-effort input can drop a sample on a loaded machine)",
-            "s",
-            0.01,
-            3600.0,
+
+    lockstep_timeout_s: float = field(
+        default=2.0,
+        metadata=param(
+            description=("lockstep: warn and re-send a sample after this long without its command"),
+            unit="s",
+            bounds=(0.01, 3600.0),
+            details="A best-effort input can drop a sample on a loaded machine.",
         ),
-        ParamSpec(
-            "wait_for",
-            list(DEFAULT_WAIT_FOR),
-            "nodes that must be up before sample 0, in both clock modes: a name in this "
-            "namespace, or fully qualified (/rosbag2_recorder); realtime with []: tick at once, "
-            "the watchdog holds zero effort until commands come",
+    )
+    wait_for: list[str] | tuple[str, ...] = field(
+        default_factory=lambda: list(DEFAULT_WAIT_FOR),
+        metadata=param(
+            description="nodes that must be up before sample 0, in either clock mode",
             read_only=True,
+            details=(
+                "A name in this namespace, or fully qualified (/rosbag2_recorder). realtime with "
+                "[]: tick at once, the watchdog holding zero effort until commands come."
+            ),
         ),
-        ParamSpec(
-            "start_with",
-            [],
-            "devices this one starts its clock with, fully qualified (/slave/device_node): "
-            "sample 0 waits until each has built its simulation (its joint_states publisher is "
-            "up), so that the two sides of a teleoperation in real time tick from the same moment",
+    )
+    start_with: list[str] | tuple[str, ...] = field(
+        default_factory=list,
+        metadata=param(
+            description=(
+                "devices this one starts its clock with, fully qualified (/slave/device_node)"
+            ),
             read_only=True,
-            items=str,
+            details=(
+                "Sample 0 waits until each has built its simulation (its joint_states publisher is "
+                "up), so that the two sides of a teleoperation in real time tick from the same "
+                "moment."
+            ),
         ),
-        ParamSpec(
-            "start_delay_s",
-            0.5,
-            "settle time between the wait_for graph being up and "
-            "sample 0 (endpoint matching between the other nodes)",
-            "s",
-            0.0,
-            60.0,
+    )
+    start_delay_s: float = field(
+        default=0.5,
+        metadata=param(
+            description="settle time between the wait_for graph being up and sample 0",
+            unit="s",
+            bounds=(0.0, 60.0),
             read_only=True,
+            details="For the endpoint matching between the other nodes.",
         ),
-        ParamSpec(
-            "stats_file",
-            "",
-            "realtime: write cycle statistics (JSON) here at shutdown",
-            read_only=True,
+    )
+    stats_file: str = field(
+        default="",
+        metadata=param(
+            description="realtime: write cycle statistics (JSON) here at shutdown", read_only=True
         ),
-        ParamSpec(
-            "max_recorder_lag_s",
-            0.5,
-            "lockstep: hold the loop while a recorder is this far behind in simulated time",
-            "s",
-            0.01,
-            3600.0,
+    )
+    max_recorder_lag_s: float = field(
+        default=0.5,
+        metadata=param(
+            description=(
+                "lockstep: hold the loop while a recorder is this far behind in simulated time"
+            ),
+            unit="s",
+            bounds=(0.01, 3600.0),
         ),
-    ]
+    )
 
 
 @dataclass(frozen=True)

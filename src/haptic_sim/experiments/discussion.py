@@ -163,16 +163,18 @@ OBSERVER_MODEL = (
     "amplifies (friction underestimated at low speed, overshoot at high frequency). Here the "
     "observer's model is least squares on chapter 4's bag: within 1 % of the plant's mass, "
     "viscous and Coulomb friction, missing its stiction and its amplifier lag (see the "
-    "configuration). What narrows the Kf = 25 band here is the observer's lag: for a large Kf "
-    "the rendered impedance rises past +3 dB near the observer's corner c / (2 pi m) (the "
-    "sweeps section). Leaving Coulomb friction out of the observer's model moves the Kf = 25 "
-    "cells further (the DOB section's last table)."
+    "configuration). For a large Kf the rendered impedance rises past +3 dB near the observer's "
+    "corner c / (2 pi m), so DOB Kf = 25's band follows its gain (the sweeps section); more "
+    "breakaway friction than the model knows renders every DOB wall softer (the sweeps "
+    "section's friction table), and leaving Coulomb friction out of the model moves the cells "
+    "further (the DOB section's last table)."
 )
 HAND_IS_A_MODEL = (
     "- **The hand is a model.** The thesis's users moved the handle themselves; here a "
-    "seeded semi-random reference (0.05-10 Hz) drives a mass-spring-damper hand, the "
-    "same for every controller; another seed moves some cells by more than the 15 % "
-    "criterion (the sweeps section's table for other seeds)."
+    "seeded semi-random reference (0.05-10 Hz, rolled off above 5 Hz) drives a "
+    "mass-spring-damper hand pushing to one depth at every wall, the same for every "
+    "controller; another seed moves some cells by more than the 15 % criterion (the sweeps "
+    "section's table for three seeds)."
 )
 ONSETS_FROM_A_PROTOCOL = (
     "- **Onsets come from a protocol, not a user.** The thesis's onsets are the lowest of "
@@ -182,14 +184,17 @@ ONSETS_FROM_A_PROTOCOL = (
     "coarse walls: with the plant's friction neither keeps any vibration after a tap (the "
     "tap table), since 0.24 N of Coulomb friction outweighs the sampled wall's small negative "
     "damping at any amplitude that keeps contact. DOB at Kf = 100, unstable at every wall "
-    "without friction, is tapped with the plant's friction kept."
+    "without friction, is tapped with the plant's friction kept, and a wall vibrates when the "
+    "hand would feel what is left 2-3 s after the tap (the vibrotactile detection threshold "
+    "at its frequency)."
 )
 OBSERVER_GAIN = (
-    "- **The slide's observer gain is not in the thesis.** One gain serves every chapter: "
-    "the fastest whole one with which DOB at the thesis's largest Kf (100) does not chatter "
-    "at the sample rate (the DOB section). Chapter 7's low-gain DOB (Kf = 1) would need a "
-    "faster observer to follow the thesis's band, which at Kf = 25 and 100 chatters (the "
-    "sweeps section)."
+    "- **The slide's observer gain is not in the thesis.** Each Kf takes a gain by a rule: the "
+    "one whose estimate is closest to the force sensor in 5.3's sessions, or the fastest that "
+    "does not chatter at that Kf if smaller (the configuration). At the thesis's Kf = 100 that "
+    "is the chatter limit's whole gain; how stiff a tapped wall it keeps quiet, and what faster "
+    "gains do (above the chatter gain the command alternates its sign every period), is in the "
+    "DOB section's tap grid."
 )
 
 
@@ -200,7 +205,8 @@ def ch7_differences(rows: list[RunAnalysis]) -> list[str]:
         ref = thesis.cell(r.mode, r.kf, r.wall)[0]
         got = r.bandwidth_hz
         if ref is not None and got is not None and abs(got - ref) > DEPARTURE * ref:
-            far.append(f"{r.where} ({got:.2f} vs {ref:g})")
+            floor = "< " if r.band_below_first_bin else ""
+            far.append(f"{r.where} ({floor}{got:.2f} vs {ref:g})")
     out = []
     if far:
         out.append(

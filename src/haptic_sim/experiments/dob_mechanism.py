@@ -18,7 +18,8 @@ varies what the linear model leaves out or what it cannot decide:
   makes the loop chatter at the sample rate (``chatter_gain``, about ``2 m / (Kf T)``).
 
 ``residual`` (``haptic_sim.slide.stability``) measures what is left 2 to 3 s after the tap; a wall
-vibrates when that exceeds ``VIBRATION_RMS_M``.
+vibrates when the hand would feel it (``felt``: its peak above the vibrotactile detection
+threshold at its frequency).
 """
 
 from __future__ import annotations
@@ -29,9 +30,9 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from haptic_dob.analysis.linear_loop import chatter_gain, linear_onset
-from haptic_sim.hand import reference_for_force
+from haptic_sim.experiments.observer_gain import gain_at
 from haptic_sim.slide.session import SessionConfig, SessionResult, run_session
-from haptic_sim.slide.stability import TAP, VIBRATION_RMS_M, law_for, tap_residual
+from haptic_sim.slide.stability import TAP, felt, law_for, tap_residual
 
 WALLS = [800.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 4000.0]
 #: observer gains c (N s/m) of the grid, beside the configuration's
@@ -63,7 +64,7 @@ class KickPoint:
     @property
     def vibrates(self) -> bool:
         """True when the motion is still there 2-3 s after the tap."""
-        return self.residual_rms_m > VIBRATION_RMS_M
+        return felt(self.residual_rms_m, self.frequency_hz)
 
 
 @dataclass(frozen=True)
@@ -136,7 +137,7 @@ class GripPoint:
     @property
     def vibrates(self) -> bool:
         """True when the motion is still there 2-3 s after the tap."""
-        return self.residual_rms_m > VIBRATION_RMS_M
+        return felt(self.residual_rms_m, self.frequency_hz)
 
 
 @dataclass(frozen=True)
@@ -268,7 +269,6 @@ def model_mismatch(
     cells: list[tuple[float, float, str]] = []
     cfgs = []
     for wall in walls:
-        offset, amplitude = reference_for_force(wall, base.hand.stiffness_n_per_m)
         for kf in kfs:
             for name, model in models.items():
                 cells.append((wall, kf, name))
@@ -276,9 +276,8 @@ def model_mismatch(
                     base.replace(
                         law=law_for("DOB", kf, base.law.max_force_n),
                         model=model,
+                        observer__gain=gain_at(kf, base),
                         wall__stiffness_n_per_m=wall,
-                        hand__offset_m=offset,
-                        hand__amplitude_m=amplitude,
                         loop__seed=seed,
                     )
                 )

@@ -20,7 +20,6 @@ from haptic_dob.bag.reader import Selection, read_bag
 from haptic_msgs_py.topics import EE_POSE, HAND_WRENCH, WRENCH_ESTIMATE, WRENCH_MEASURED
 from haptic_sim.experiments.graph_runs import GraphRun, session_params
 from haptic_sim.experiments.records import Cell, RunAnalysis
-from haptic_sim.hand import reference_for_force
 from haptic_sim.slide.session import SessionConfig
 
 WALLS = (0.0, 800.0)  # N/m: free space, the thesis's wall
@@ -60,12 +59,9 @@ def run_name(wall: float) -> str:
 
 def chapter5_runs(base_config: Path, seed: int = 0, _quick: bool = False) -> list[GraphRun]:
     """The free-space session and the wall session (OL, the observer beside the loop)."""
-    k_h = float(session_params(base_config, {})["device_node"]["hand.stiffness_n_per_m"])
     runs = []
     for wall in WALLS:
-        offset, amplitude = (
-            (0.0, FREE_AMPLITUDE_M) if wall == 0.0 else reference_for_force(wall, k_h)
-        )
+        hand = {"hand.offset_m": 0.0, "hand.amplitude_m": FREE_AMPLITUDE_M} if wall == 0.0 else {}
         params = session_params(
             base_config,
             {
@@ -74,8 +70,7 @@ def chapter5_runs(base_config: Path, seed: int = 0, _quick: bool = False) -> lis
                     "wait_for": ["environment_node", "observer_node", "controller_node"],
                     "duration_s": DURATION_S,
                     "seed": seed,
-                    "hand.offset_m": offset,
-                    "hand.amplitude_m": amplitude,
+                    **hand,
                 },
                 "environment_node": {"stiffness_n_per_m": wall},
                 "recorder_node": {"topics": RECORDED},

@@ -1,11 +1,13 @@
 """What the reproduction runs: the thesis's chapter 7 and chapter 6 sessions as node-graph runs.
 
 Chapter 7 (transparency): OL, CL with Kf = 2, DOB with Kf = 1 and Kf = 25 on walls of 80, 800,
-1600 and 2400 N/m, 40 s of semi-random hand motion each (the same seed for every cell, so every
-controller meets the same hand). The hand's push and swing follow the wall
-(``reference_for_force``). OL and CL runs leave the observer out (they do not use it) and the
+1600 and 2400 N/m (thesis 7.1), 40 s of semi-random hand motion each (the same seed for every
+cell, so every controller meets the same hand). The hand pushes to the configuration's depth
+at every wall (``haptic_sim.hand.depth_reference``); DOB takes the observer gain of its Kf
+(``observer_gain.gain_at``). OL and CL runs leave the observer out (they do not use it) and the
 controller subscribes only to its own mode's input; the recorder records what the analysis reads.
-The quick variant (the demo) runs OL, CL Kf = 2 and DOB Kf = 1 at 800 N/m for 20 s.
+The quick variant (the demo) runs OL, CL Kf = 2 and DOB Kf = 1 at 800 N/m, 40 s each (as
+chapter 7: the 4 s spectral segments need the whole session's averages).
 
 Chapter 6 (vibration onset, through the graph), the thesis's user trying to provoke vibration:
 a light 20 N/m grip pushing 1 N into the wall, 4-4.5 s per wall, in two protocols of
@@ -22,17 +24,18 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from haptic_sim.experiments import thesis
 from haptic_sim.experiments.graph_runs import GraphRun, session_params
+from haptic_sim.experiments.observer_gain import gain_at
 from haptic_sim.experiments.records import Cell, label
-from haptic_sim.hand import reference_for_force
+from haptic_sim.slide.session import SessionConfig
 from haptic_sim.slide.stability import TAP, StabilityProtocol
 
+#: chapter 7's controllers and walls (N/m), as thesis 7.1's text names them
 CH7_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0), ("DOB", 25.0)]
-CH7_WALLS: list[float] = list(thesis.WALLS)
+CH7_WALLS: list[float] = [80.0, 800.0, 1600.0, 2400.0]
 QUICK_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 1.0)]
 QUICK_WALLS: list[float] = [800.0]
-QUICK_DURATION_S = 20.0
+QUICK_DURATION_S = 40.0
 CH6_CONTROLLERS: list[tuple[str, float]] = [("OL", 0.0), ("CL", 2.0), ("DOB", 100.0)]
 #: the linear protocol: the thesis's walls (800-3200 N/m) and points around the OL and CL bounds
 #: (2544, 848 N/m); DOB at two (unstable at every wall)
@@ -59,13 +62,17 @@ def _loop_nodes(mode: str) -> list[str]:
 
 
 def _run(base_config: Path, cell: Cell, extra: dict[str, dict[str, Any]]) -> GraphRun:
-    """The graph run of one cell: the base config, the controller, ``extra`` over them."""
+    """The graph run of one cell: the base config, the controller (DOB: the observer gain of
+    its Kf), ``extra`` over them."""
     overrides = {
         "controller_node": {"mode": cell.mode, "kf": cell.kf, "warm_inputs": False},
         "device_node": {"wait_for": _loop_nodes(cell.mode), **extra.pop("device_node", {})},
         "recorder_node": {"topics": RECORDED},
         **extra,
     }
+    if cell.mode == "DOB":
+        base = SessionConfig.from_node_params(session_params(base_config, {}))
+        overrides["observer_node"] = {"gain": gain_at(cell.kf, base)}
     params = session_params(base_config, overrides)
     if cell.mode != "DOB":
         params.pop("observer_node", None)
@@ -81,19 +88,12 @@ def chapter7_runs(
     controllers: list[tuple[str, float]] | None = None,
     walls: list[float] | None = None,
 ) -> list[GraphRun]:
-    """The transparency cells as graph runs."""
-    k_h = float(session_params(base_config, {})["device_node"]["hand.stiffness_n_per_m"])
+    """The transparency cells as graph runs (the configuration's hand at every wall)."""
     runs = []
     for mode, kf in controllers or CH7_CONTROLLERS:
         for wall in walls or CH7_WALLS:
-            offset, amplitude = reference_for_force(wall, k_h)
             extra = {
-                "device_node": {
-                    "duration_s": duration_s,
-                    "seed": seed,
-                    "hand.offset_m": offset,
-                    "hand.amplitude_m": amplitude,
-                },
+                "device_node": {"duration_s": duration_s, "seed": seed},
                 "environment_node": {"stiffness_n_per_m": wall},
             }
             runs.append(_run(base_config, Cell("ch7", mode, kf, wall), extra))

@@ -51,6 +51,7 @@ class RunAnalysis:
     stiffness_n_per_m: float | None = None  # as recorded
     bandwidth_hz: float | None = None
     band_limited_by_fmax: bool | None = None
+    band_below_first_bin: bool | None = None
     impedance_error_pct: float | None = None
     coherence_in_band: float | None = None
     in_contact_pct: float | None = None

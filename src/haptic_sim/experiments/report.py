@@ -12,9 +12,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from haptic_sim.experiments.configuration import config_table
 from haptic_sim.experiments.parts import Experiment, present
 from haptic_sim.experiments.records import ExperimentResults
-from haptic_sim.experiments.tables import config_table
 from haptic_sim.slide.session import SessionConfig
 
 

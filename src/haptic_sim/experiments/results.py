@@ -35,6 +35,8 @@ from haptic_sim.slide.stability import StabilityPoint, StabilityProtocol, onset
 
 #: a chapter-7 cell: (mode, Kf, wall in N/m)
 CellKey = tuple[str, float, float]
+#: Table 7.1's cells within 15 % that the reproduction aims at (issue 35)
+TABLE_TARGET = 10
 
 
 def analyse_run(root: Path, run: GraphRun) -> RunAnalysis:
@@ -75,17 +77,31 @@ def ch7_checks(rows: list[RunAnalysis]) -> list[Check]:
     """The issue's acceptance checks on the chapter-7 cells that were run."""
     bw = {(r.mode, r.kf, r.wall): r.bandwidth_hz for r in rows}
     checks = []
+    below = {(r.mode, r.kf, r.wall) for r in rows if r.band_below_first_bin}
     for wall in thesis.WALLS[:3]:
         got = bw.get(("OL", 0.0, wall))
         ref = thesis.cell("OL", 0.0, wall)[0]
         if got is not None and ref is not None:
+            floor = ("OL", 0.0, wall) in below
             checks.append(
                 Check(
-                    f"OL bandwidth at {wall:g} N/m {got:.2f} Hz within +-15 % of the thesis's "
-                    f"{ref:g} Hz",
-                    abs(got - ref) <= 0.15 * ref,
+                    f"OL bandwidth at {wall:g} N/m {'< ' if floor else ''}{got:.2f} Hz within "
+                    f"+-15 % of the thesis's {ref:g} Hz",
+                    not floor and thesis.within("OL", 0.0, wall, got),
                 )
             )
+    if len(bw) == len(CH7_CONTROLLERS) * len(CH7_WALLS):
+        n = sum(
+            thesis.within(r.mode, r.kf, r.wall, None if r.band_below_first_bin else r.bandwidth_hz)
+            for r in rows
+        )
+        checks.append(
+            Check(
+                f"Table 7.1: {n} of {len(bw)} cells within +-15 % of the thesis (at least "
+                f"{TABLE_TARGET} wanted)",
+                n >= TABLE_TARGET,
+            )
+        )
     for mode, kf in (("CL", 2.0), ("DOB", 1.0)):
         for wall in (800.0, 1600.0):
             got, ol = bw.get((mode, kf, wall)), bw.get(("OL", 0.0, wall))

@@ -1,26 +1,31 @@
 """Table 7.1's cells that stay off, each swept against the parameter responsible (batch).
 
 - **2400 N/m against the hand's grip damping.** The bandwidth is the first frequency where the
-  rendered impedance falls 3 dB below the wall's. At 2400 N/m OL renders the wall 1.5-3 dB soft
-  across the whole band, so that edge is ill-conditioned: with the chapter-7 grip (10 N s/m) it
-  lies near 6 Hz, with a looser one (the bench hand's 5 N s/m, and below) the first bin passes
-  -3 dB and the band ends there, which fits the thesis's 0.6 Hz.
-- **80 N/m against the actuator's force limit.** At a soft wall the hand's swing moves the
-  handle centimetres; force feedback multiplies the force error by ``1 + Kf``, and CL Kf = 2 and
-  DOB Kf = 25 spend much of the session at the 4 N limit: the loop is not linear there, the
-  coherence collapses and the band ends at the first bin. A larger limit restores the coherence.
-- **Every wall against the observer gain (DOB).** For a large Kf the rendered impedance rises past
-  +3 dB near the observer's corner ``c / (2 pi m)``, so DOB Kf = 25's band follows c; DOB Kf = 1
-  needs a fast observer to reach the mass line ``m / 2`` the thesis's cells sit near, and a gain
-  that fast chatters at Kf = 25 (above about ``2 m / (Kf T)``: the time at the limit).
+  rendered impedance leaves the 3 dB band around the wall's. At 2400 N/m OL renders the wall
+  soft across the whole band, so that edge is ill-conditioned and follows the hand's grip.
+- **OL at 2400 N/m, a loose grip, against Coulomb friction.** The thesis's user could sustain
+  OL vibration at 2400 N/m (6.3); the simulated friction stops it. Without friction (plant and
+  model) and without grip damping the wall keeps vibrating through the session: what that does
+  to its band.
+- **80 N/m against the hand's depth.** The depth-regulating hand pushes a soft wall only a
+  little (0.47 N at 80 N/m, thesis 7.3.2: "close to the frictional force"); the reference's
+  offset and amplitude scaled together show what a deeper push does to the friction-dominated
+  cells.
+- **Every wall against the observer gain (DOB).** For a large Kf the rendered impedance rises
+  past +3 dB near the observer's corner ``c / (2 pi m)``, so DOB Kf = 25's band follows c; the
+  gain rule (``observer_gain``) gives Kf = 25 the fastest gain that does not chatter.
+- **Every wall against the plant's low-speed friction (DOB).** The thesis (7.3.3.1) blames the
+  high-gain DOB's errors on friction at low speed that the observer's model leaves out; the
+  breakaway ratio is swept up to 2.5 (0.6 N), where chapter 4.3's 0.6 N sine no longer breaks
+  the slide away (the thesis's device tracked it).
 - **1600 and 2400 N/m against the force sensor's bandwidth (CL).** CL's band follows the mass line
   ``m / (1 + Kf)`` above the thesis's 4.5 Hz; a slower sensor lowers it only when it also lowers
   the CL onset of chapter 6's linear protocol below the thesis's 800 N/m (the onset column).
 
-Each sweep's first value is the chapter-7 session's (read from the configuration); the cells
-show the bandwidth, coherence, the rendering's magnitude at the first bin and up to 5 Hz, and the
-time at the force limit, so the report shows the mechanism rather than a constant fitted to the
-table.
+Each sweep's first value is the chapter-7 session's (read from the configuration, per Kf for
+the observer gain); the cells show the bandwidth, coherence, the rendering's magnitude at the
+first bin and up to 5 Hz, and the time at the force limit, so the report shows the mechanism
+rather than a constant fitted to the table.
 """
 
 from __future__ import annotations
@@ -32,9 +37,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from haptic_dob.analysis.transparency import transparency
-from haptic_sim.experiments import spread, thesis
-from haptic_sim.experiments.tables import fmt
-from haptic_sim.hand import reference_for_force
+from haptic_sim.experiments import spread
+from haptic_sim.experiments.observer_gain import gain_at
+from haptic_sim.experiments.plan import CH7_CONTROLLERS, CH7_WALLS
 from haptic_sim.slide.session import SessionConfig, run_session
 from haptic_sim.slide.stability import law_for
 from haptic_sim.slide.stability import sweep as stability_sweep
@@ -45,41 +50,69 @@ DURATION_S = 40.0  # each session, as chapter 7's
 Controller = tuple[str, float]
 
 
+def _law(cfg: SessionConfig, mode: str, kf: float) -> SessionConfig:
+    """The chapter-7 law (DOB: with the observer gain of its Kf)."""
+    out = cfg.replace(law=law_for(mode, kf, cfg.law.max_force_n))
+    return out.replace(observer__gain=gain_at(kf, cfg)) if mode == "DOB" else out
+
+
 def _grip(cfg: SessionConfig, mode: str, kf: float, damping: float) -> SessionConfig:
     """The chapter-7 law, the hand's grip damping (N s/m) at ``damping``."""
-    law = law_for(mode, kf, cfg.law.max_force_n)
-    return cfg.replace(law=law, hand__damping_n_s_per_m=damping)
+    return _law(cfg, mode, kf).replace(hand__damping_n_s_per_m=damping)
 
 
-def _force_limit(cfg: SessionConfig, mode: str, kf: float, limit: float) -> SessionConfig:
-    """The law's and the actuator's force limit (N) at ``limit``."""
-    return cfg.replace(law=law_for(mode, kf, limit), device__max_force_n=limit)
+def _depth(cfg: SessionConfig, mode: str, kf: float, scale: float) -> SessionConfig:
+    """The chapter-7 law, the hand's reference offset and amplitude times ``scale``."""
+    h = cfg.hand
+    return _law(cfg, mode, kf).replace(
+        hand__offset_m=h.offset_m * scale, hand__amplitude_m=h.amplitude_m * scale
+    )
 
 
 def _observer_gain(cfg: SessionConfig, mode: str, kf: float, gain: float) -> SessionConfig:
     """The chapter-7 law, the observer gain (N s/m) at ``gain``."""
-    return cfg.replace(law=law_for(mode, kf, cfg.law.max_force_n), observer__gain=gain)
+    return _law(cfg, mode, kf).replace(observer__gain=gain)
+
+
+def _loose_coulomb(cfg: SessionConfig, mode: str, kf: float, coulomb: float) -> SessionConfig:
+    """The chapter-7 law with a loose grip (no damping), Coulomb friction (N) at ``coulomb`` in
+    the plant and the observer's model."""
+    return _law(cfg, mode, kf).replace(
+        hand__damping_n_s_per_m=0.0, device__coulomb_n=coulomb, model__coulomb_n=coulomb
+    )
+
+
+def _stiction(cfg: SessionConfig, mode: str, kf: float, ratio: float) -> SessionConfig:
+    """The chapter-7 law, the plant's breakaway friction at ``ratio`` times Coulomb."""
+    return _law(cfg, mode, kf).replace(device__stiction_ratio=ratio)
 
 
 def _sensor(cfg: SessionConfig, mode: str, kf: float, bandwidth: float) -> SessionConfig:
     """The chapter-7 law, the force sensor's bandwidth (Hz) at ``bandwidth``."""
-    law = law_for(mode, kf, cfg.law.max_force_n)
-    return cfg.replace(law=law, sensor__bandwidth_hz=bandwidth)
+    return _law(cfg, mode, kf).replace(sensor__bandwidth_hz=bandwidth)
 
 
-def _hand_damping(b: SessionConfig) -> float:
+def _hand_damping(b: SessionConfig, _kf: float) -> float:
     return b.hand.damping_n_s_per_m
 
 
-def _max_force(b: SessionConfig) -> float:
-    return b.device.max_force_n
+def _unit_scale(_b: SessionConfig, _kf: float) -> float:
+    return 1.0
 
 
-def _gain(b: SessionConfig) -> float:
-    return b.observer.gain
+def _gain(b: SessionConfig, kf: float) -> float:
+    return gain_at(kf, b)
 
 
-def _sensor_bandwidth(b: SessionConfig) -> float:
+def _coulomb(b: SessionConfig, _kf: float) -> float:
+    return b.device.coulomb_n
+
+
+def _stiction_ratio(b: SessionConfig, _kf: float) -> float:
+    return b.device.stiction_ratio
+
+
+def _sensor_bandwidth(b: SessionConfig, _kf: float) -> float:
     return b.sensor.bandwidth_hz
 
 
@@ -90,57 +123,57 @@ class Sweep:
     name: str
     walls: tuple[float, ...]  # N/m
     parameter: str  # with its unit
-    current: Callable[[SessionConfig], float]  # the chapter-7 session's value, swept first
+    current: Callable[[SessionConfig, float], float]  # the chapter-7 value at a Kf, swept first
     values: tuple[float, ...]  # the others
     apply: Callable[[SessionConfig, str, float, float], SessionConfig]  # (cfg, mode, Kf, value)
-    controllers: tuple[Controller, ...] = tuple(thesis.BANDWIDTH_HZ)
+    controllers: tuple[Controller, ...] = tuple(CH7_CONTROLLERS)
     onset_walls: tuple[float, ...] = ()  # chapter 6's linear onset over these walls, if any
     # (once per value: the onset does not depend on chapter 7's wall)
 
-    def values_for(self, base: SessionConfig) -> tuple[float, ...]:
-        """The chapter-7 value first, then the others."""
-        now = self.current(base)
+    def values_for(self, base: SessionConfig, kf: float) -> tuple[float, ...]:
+        """The chapter-7 value at ``kf`` first, then the others."""
+        now = self.current(base, kf)
         return (now, *(v for v in self.values if v != now))
 
     def config(
         self, base: SessionConfig, mode: str, kf: float, wall: float, value: float
     ) -> SessionConfig:
         """The chapter-7 session at ``wall`` (N/m) with the parameter at ``value``."""
-        offset, amplitude = reference_for_force(wall, base.hand.stiffness_n_per_m)
         at_wall = base.replace(
-            wall__stiffness_n_per_m=wall,
-            hand__offset_m=offset,
-            hand__amplitude_m=amplitude,
-            loop__seed=SEED,
-            loop__duration_s=DURATION_S,
+            wall__stiffness_n_per_m=wall, loop__seed=SEED, loop__duration_s=DURATION_S
         )
         return self.apply(at_wall, mode, kf, value)
 
 
-GRIP = Sweep(
-    "grip",
+GRIP = Sweep("grip", (2400.0,), "grip damping (N s/m)", _hand_damping, (5.0, 2.0), _grip)
+VIBRATING = Sweep(
+    "vibrating",
     (2400.0,),
-    "grip damping (N s/m)",
-    _hand_damping,
-    (5.0, 2.0),
-    _grip,
+    "Coulomb friction of the plant and the model (N), the grip without damping",
+    _coulomb,
+    (0.0,),
+    _loose_coulomb,
+    (("OL", 0.0),),
 )
-FORCE_LIMIT = Sweep(
-    "force_limit",
-    (80.0,),
-    "force limit (N)",
-    _max_force,
-    (8.0, 16.0),
-    _force_limit,
-    (("CL", 2.0), ("DOB", 25.0)),
+DEPTH = Sweep(
+    "depth", (80.0,), "hand's depth (times the configuration's)", _unit_scale, (2.0, 4.0), _depth
 )
 OBSERVER = Sweep(
     "observer",
-    tuple(thesis.WALLS),
+    tuple(CH7_WALLS),
     "observer gain (N s/m)",
     _gain,
-    (10.0, 41.6),
+    (7.0, 10.0, 30.0, 146.0),
     _observer_gain,
+    (("DOB", 1.0), ("DOB", 25.0)),
+)
+FRICTION = Sweep(
+    "friction",
+    tuple(CH7_WALLS),
+    "plant's breakaway friction (times Coulomb)",
+    _stiction_ratio,
+    (2.0, 2.5),
+    _stiction,
     (("DOB", 1.0), ("DOB", 25.0)),
 )
 SENSOR = Sweep(
@@ -153,7 +186,7 @@ SENSOR = Sweep(
     (("CL", 2.0),),
     (400.0, 500.0, 600.0, 700.0, 800.0, 900.0, 1000.0),
 )
-SWEEPS = (GRIP, FORCE_LIMIT, OBSERVER, SENSOR)
+SWEEPS = (GRIP, VIBRATING, DEPTH, OBSERVER, FRICTION, SENSOR)
 
 
 @dataclass(frozen=True)
@@ -172,6 +205,7 @@ class SweepCell:
     mean_db_to_5hz: float | None  # its mean over the bins up to 5 Hz (dB)
     saturated_pct: float  # of the samples, the command at the force limit
     onset_n_per_m: float | None = None  # chapter 6's linear onset (a sweep with onset walls)
+    below_first_bin: bool = False  # the band ends below the first bin (bandwidth: that bin's)
 
 
 @dataclass(frozen=True)
@@ -203,6 +237,7 @@ class _Measured:
     saturated_pct: float
     onset_n_per_m: float | None  # chapter 6's linear onset over the job's walls, if any
     table_bandwidth_hz: float | None  # the session summary's, as Table 7.1 and ``spread`` read it
+    below: bool  # the summary's band ends below the first bin
 
 
 Job = tuple[SessionConfig, tuple[float, ...]]  # a session, and the walls of its onset (or ())
@@ -217,13 +252,14 @@ def _measure(job: Job) -> _Measured:
     onset = None
     if onset_walls:
         onset = stability_sweep(list(onset_walls), cfg).onset_stiffness_n_per_m
-    table_bw = res.summary(SETTLE_S).bandwidth_hz
+    summary = res.summary(SETTLE_S)
+    table_bw, below = summary.bandwidth_hz, summary.band_below_first_bin
     try:
         tr = transparency(
             res.q[k0:], res.force_measured[k0:], cfg.loop.rate_hz, cfg.wall.stiffness_n_per_m
         )
     except ValueError:  # no motion to measure
-        return _Measured(None, None, None, None, None, saturated, onset, table_bw)
+        return _Measured(None, None, None, None, None, saturated, onset, table_bw, below)
     db = tr.magnitude_db
     return _Measured(
         tr.bandwidth_hz,
@@ -234,6 +270,7 @@ def _measure(job: Job) -> _Measured:
         saturated,
         onset,
         table_bw,
+        below,
     )
 
 
@@ -257,6 +294,7 @@ def _cell(sweep: Sweep, mode: str, kf: float, wall: float, value: float, m: _Mea
         m.mean_db_to_5hz,
         m.saturated_pct,
         onset,
+        m.below,
     )
 
 
@@ -276,7 +314,7 @@ def study(base: SessionConfig, executor: Executor | None = None) -> SweepStudy:
         for s in SWEEPS
         for (mode, kf) in s.controllers
         for wall in s.walls
-        for v in s.values_for(base)
+        for v in s.values_for(base, kf)
     ]
     seeds = spread.cells(base)
     runs: dict[SessionConfig, tuple[float, ...]] = {}  # each distinct session: its onset walls
@@ -293,48 +331,9 @@ def study(base: SessionConfig, executor: Executor | None = None) -> SweepStudy:
         for s, mode, kf, wall, v in specs
     ]
     return SweepStudy(
-        cells, [c.with_bandwidth(by_config[c.config].table_bandwidth_hz) for c in seeds]
+        cells,
+        [
+            c.with_bandwidth(by_config[c.config].table_bandwidth_hz, by_config[c.config].below)
+            for c in seeds
+        ],
     )
-
-
-def label(mode: str, kf: float) -> str:
-    """``OL``, ``CL Kf=2``..."""
-    return mode if mode == "OL" else f"{mode} Kf={kf:g}"
-
-
-def _cell_text(c: SweepCell) -> str:
-    onset = "" if c.onset_n_per_m is None else f"; onset {c.onset_n_per_m:.0f}"
-    return (
-        f"{fmt(c.bandwidth_hz)} ({fmt(c.coherence_in_band)}); "
-        f"{fmt(c.first_bin_db, '+.1f')} / {fmt(c.mean_db_to_5hz, '+.1f')}; "
-        f"{c.saturated_pct:.0f} %{onset}"
-    )
-
-
-def sweep_table(r: SweepStudy, sweep: Sweep) -> str:
-    """One sweep's table: a row per controller and wall, a column per value (in the order run),
-    the thesis's cell last; chapter 6's linear onset per value where the sweep measures it."""
-    values = list(dict.fromkeys(c.value for c in r.cells if c.sweep == sweep.name))
-    if not values:
-        return ""
-    walls = ", ".join(f"{w:g}" for w in sweep.walls)
-    lines = [
-        f"**{walls} N/m against the {sweep.parameter}** (the first column is chapter 7's): "
-        "bandwidth in Hz (coherence in the band); |Z_hat / Z_d| at the first bin / its mean up "
-        "to 5 Hz (dB); time at the force limit"
-        + ("; chapter 6's linear onset (N/m)" if sweep.onset_walls else "")
-        + ":",
-        "",
-        "| | " + " | ".join(f"{v:g}" for v in values) + " | thesis (Hz) |",
-        "|---|" + "---|" * (len(values) + 1),
-    ]
-    for mode, kf in sweep.controllers:
-        for wall in sweep.walls:
-            by_value = {c.value: c for c in r.of(sweep.name, mode, kf, wall)}
-            if not by_value:
-                continue
-            cols = [_cell_text(by_value[v]) if v in by_value else "-" for v in values]
-            ref = thesis.cell(mode, kf, wall)[0]
-            name = label(mode, kf) + ("" if len(sweep.walls) == 1 else f", {wall:g} N/m")
-            lines.append(f"| {name} | " + " | ".join(cols) + f" | {fmt(ref, 'g')} |")
-    return "\n".join(lines) + "\n"

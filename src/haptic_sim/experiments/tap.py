@@ -5,7 +5,8 @@ keeps it quiet, if anything, is the plant's friction and the actuator's saturati
 linear protocol leaves out. The tap protocol (``haptic_sim.slide.stability.TAP``) keeps the
 configuration's plant and observer model as they are and taps the handle with 3 N for 20 ms; each
 run's bag gives the motion 2-3 s after the tap (RMS about its slow trend, from the encoder's
-``ee_pose``), and a wall vibrates when that exceeds ``VIBRATION_RMS_M``. OL and CL are tapped too:
+``ee_pose``), and a wall vibrates when the hand would feel that motion (``felt``: its peak above
+the vibrotactile detection threshold at its frequency). OL and CL are tapped too:
 with friction they keep no vibration, which is why their onsets come from the linear protocol.
 """
 
@@ -16,7 +17,7 @@ import numpy as np
 from haptic_dob.bag.reader import Selection, read_bag
 from haptic_sim.experiments import thesis
 from haptic_sim.experiments.records import Check, RunAnalysis, TapPoint, TapSweep, label
-from haptic_sim.slide.stability import TAP, VIBRATION_RMS_M, StabilityProtocol, residual
+from haptic_sim.slide.stability import TAP, StabilityProtocol, felt, residual
 
 #: the DOB onset is compared with the thesis's within this (relative)
 WITHIN = 0.15
@@ -30,7 +31,7 @@ def tap_point_of(
     end = protocol.duration_s
     last = np.asarray(x_m, dtype=np.float64)[(t_s >= end - 1.0) & (t_s < end)]
     rms, freq = residual(last, rate_hz, 0.0, last.size / rate_hz)
-    return TapPoint(wall, rms, freq, rms > VIBRATION_RMS_M)
+    return TapPoint(wall, rms, freq, felt(rms, freq))
 
 
 def tap_point(row: RunAnalysis, rate_hz: float) -> TapPoint:

@@ -33,19 +33,16 @@ refused, limited and foreign commands.
 
 from __future__ import annotations
 
-import json
-import os
 import sys
 from collections.abc import Callable
-from dataclasses import asdict
 from typing import Any
 
 from rclpy.context import Context
 
 from haptic_dob.nodes.command_input import CommandInput
 from haptic_dob.nodes.common import main_for, missing_nodes
-from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
-from haptic_dob.runtime.ros.params import ParameterTable
+from haptic_dob.runtime.cpus import scheduling
+from haptic_dob.runtime.ros.diagnostics import Diagnostics, Report, report_of
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py import codecs
 from haptic_msgs_py.ros import qos
@@ -66,6 +63,7 @@ from haptic_msgs_py.values import JointSample, Stamp, StampedVector
 from haptic_sim.device.cycle_stats import CycleStats
 from haptic_sim.device.factory import build_device
 from haptic_sim.device.loop import DeviceLoop
+from haptic_sim.device.report import device_status
 from haptic_sim.device.sample import DeviceSample
 from haptic_sim.device.settings import (
     DeviceLoopSettings,
@@ -83,8 +81,7 @@ class DeviceNode(LoopNode):
         name: str = "device_node",
         namespace: str | None = None,
     ) -> None:
-        super().__init__(name, context=context, namespace=namespace)
-        self.params = ParameterTable(self, device_node_specs())
+        super().__init__(name, specs=device_node_specs(), context=context, namespace=namespace)
         v = self.params.values
         self._start_with = start_topics(v["start_with"])
         self.device = build_device(v)
@@ -211,35 +208,7 @@ class DeviceNode(LoopNode):
         self.loop.wakeup(now)
 
     def _report(self) -> Report:
-        loop = self.loop
-        tripped = loop.watchdog.tripped
-        values: dict[str, Any] = {
-            "clock_mode": "lockstep" if self.lockstep else "realtime",
-            "cycle": self.device.k,
-            "watchdog": "tripped: effort zeroed" if tripped else "ok",
-            "watchdog_trips": loop.watchdog.trips,
-            "refused_commands": loop.guard.refused,
-            "limited_commands": loop.guard.limited,
-            "effort_limits": list(self.limits),
-            **self._sub.report(),
-        }
-        if not self.lockstep:
-            rt = loop.realtime
-            values.update(
-                overruns=rt.overruns,
-                missed_ticks=rt.missed_ticks,
-                late_commands=rt.late,
-                on_time_commands=rt.on_time,
-            )
-        if tripped:
-            return WARN, "watchdog tripped: no valid effort_command, effort zeroed", values
-        if loop.guard.refusing:
-            return WARN, "refusing invalid effort_command (zero effort)", values
-        if self._sub.refusing():
-            return WARN, "refused effort_command from publishers other than the loop's", values
-        if not loop.started:
-            return OK, "waiting for the graph", values
-        return OK, "running", values
+        return report_of(device_status(self.loop, self._sub.report(), self._sub.refusing))
 
     def stats(self) -> CycleStats:
         """Real-time cycle statistics so far (what ``stats_file`` gets)."""
@@ -249,17 +218,9 @@ class DeviceNode(LoopNode):
         """Zero effort first; in real time one last period runs and is reported with it."""
         path = self.params.values["stats_file"]
         if path and not self.lockstep:
-            with open(path, "w", encoding="utf-8") as fh:
-                json.dump(asdict(self.stats()), fh, indent=2)
+            self.stats().write(path)
         self.loop.shutdown()
         self.log.info("shutdown: effort zeroed")
-
-
-def scheduling() -> str:
-    """This process's CPU scheduling: ``SCHED_FIFO priority 50`` or ``normal``."""
-    if hasattr(os, "sched_getscheduler") and os.sched_getscheduler(0) == os.SCHED_FIFO:
-        return f"SCHED_FIFO priority {os.sched_getparam(0).sched_priority}"
-    return "normal"
 
 
 def main(args: list[str] | None = None) -> int:

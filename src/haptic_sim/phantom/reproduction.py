@@ -1,21 +1,17 @@
 """Thesis section 5.2 on the simulated PHANToM 1.5: batch reproductions and their figures.
 
-- 5.2.1, free motion under gravity: no actuation, the observer's model leaves G out
-  (``PhantomModel(gravity=False)``), gain c = 2, so the estimate should track ``-G(q)``. Reported:
-  RMS and peak of ``d_hat - (-G)`` per joint (N m), after the first 0.1 s (the start-up).
-- 5.2.2, a virtual wall (1000 N/m, undamped) 0.01 m below the start, gravity pulling the device
-  into it, no hand, DOB control with Kf = 1 and Kf = 50, the observer's model again without G (so
-  gravity is the "operator" whose force the observer estimates), once with the observer's wrench
-  and once with the exact one (``ArmSessionConfig.exact_force``). The device is held at rest for
-  ``hold_s`` while the observer converges, then released (t = 0). Reported per Kf: the largest
-  distance between the two end-effector trajectories over the comparison window, the same for two
-  exact runs whose start differs by 1e-6 rad on phi2 (how fast this undamped system separates any
-  two nearby runs), and the oscillation: peak-to-peak height of the end effector after first
-  contact.
+- 5.2.1, free motion under gravity: no actuation, the observer's model without G
+  (``PhantomModel(gravity=False)``), gain c = 2. Reported: RMS and peak of ``d_hat - (-G)`` per
+  joint (N m), after the first 0.1 s.
+- 5.2.2, a 1000 N/m undamped wall 0.01 m below the start, gravity pulling the device into it, no
+  hand, DOB with Kf = 1 and Kf = 50, the observer's model again without G; once with the
+  observer's wrench, once with the exact one (``ArmSessionConfig.exact_force``); held at rest for
+  ``hold_s``, then released (t = 0). Reported per Kf: the largest distance between the two tip
+  trajectories over the comparison window, the same for two exact runs 1e-6 rad apart on phi2,
+  and the peak-to-peak height of the tip after first contact.
 
-Both use the appendix-B parameters, the ideal encoder and the exact joint velocity (the thesis's
-simulation had exact states; ``velocity='difference'`` gives what a driver's backward difference
-does). Figures are written as PNG with matplotlib's Agg backend.
+Both: appendix-B parameters, ideal encoder, exact joint velocity (``velocity='difference'``:
+a driver's backward difference); figures as PNG (matplotlib's Agg). docs/design/arms.md.
 """
 
 from __future__ import annotations

@@ -49,51 +49,83 @@ class PointMassDeviceParams:
 
     mass_kg: Vec3 = field(
         default=(0.25, 0.22, 0.28),
-        metadata=param("the plant's true moving mass per axis (x, y, z)", "kg", 1e-3, 100.0),
+        metadata=param(
+            description="the plant's true moving mass per axis (x, y, z)",
+            unit="kg",
+            bounds=(1e-3, 100.0),
+        ),
     )
     viscous_n_s_per_m: Vec3 = field(
         default=(1.0, 0.8, 1.2),
-        metadata=param("the plant's true viscous friction per axis", "N s/m", 0.0, 1e3),
+        metadata=param(
+            description="the plant's true viscous friction per axis",
+            unit="N s/m",
+            bounds=(0.0, 1e3),
+        ),
     )
     coulomb_n: Vec3 = field(
         default=(0.06, 0.05, 0.08),
-        metadata=param("the plant's true Coulomb (sliding) friction per axis", "N", 0.0, 100.0),
+        metadata=param(
+            description="the plant's true Coulomb (sliding) friction per axis",
+            unit="N",
+            bounds=(0.0, 100.0),
+        ),
     )
     stiction_ratio: float = field(
         default=1.5,
-        metadata=param("static friction (breakaway) over the Coulomb level", "", 1.0, 10.0),
+        metadata=param(
+            description="static friction (breakaway) over the Coulomb level", bounds=(1.0, 10.0)
+        ),
     )
     stribeck_velocity_m_per_s: float = field(
         default=0.005,
-        metadata=param("speed over which friction falls from static to Coulomb", "m/s", 0.0, 1.0),
+        metadata=param(
+            description="speed over which friction falls from static to Coulomb",
+            unit="m/s",
+            bounds=(0.0, 1.0),
+        ),
     )
     amplifier_lag_s: float = field(
         default=1e-4,
-        metadata=param("time constant of the amplifiers' current loops", "s", 0.0, 0.1),
+        metadata=param(
+            description="time constant of the amplifiers' current loops",
+            unit="s",
+            bounds=(0.0, 0.1),
+        ),
     )
     max_force_n: float = field(
         default=FD_MAX_FORCE_N,
-        metadata=param("actuator saturation per axis (the SDK's cap)", "N", 1e-3, 1e3),
+        metadata=param(
+            description="actuator saturation per axis (the SDK's cap)", unit="N", bounds=(1e-3, 1e3)
+        ),
     )
     encoder_resolution_m: float = field(
-        default=2e-6, metadata=param("encoder resolution per axis", "m", 1e-12, 1e-2)
+        default=2e-6,
+        metadata=param(description="encoder resolution per axis", unit="m", bounds=(1e-12, 1e-2)),
     )
     encoder_noise_m: float = field(
         default=5e-7,
         metadata=param(
-            "white noise on the position before the encoder counts (std)", "m", 0.0, 1e-2
+            description="white noise on the position before the encoder counts (std)",
+            unit="m",
+            bounds=(0.0, 1e-2),
         ),
     )
     initial_position: Vec3 = field(
-        default=(0.0, 0.0, 0.0), metadata=param("end-effector point at start (x, y, z)", "m")
+        default=(0.0, 0.0, 0.0),
+        metadata=param(description="end-effector point at start (x, y, z)", unit="m"),
     )
     hand_direction: Vec3 = field(
         default=(0.0, 0.0, -1.0),
-        metadata=param("direction of the hand's push (unit 3-vector, base frame)"),
+        metadata=param(description="direction of the hand's push (unit 3-vector, base frame)"),
     )
     hand_lateral_amplitude_m: float = field(
         default=0.0,
-        metadata=param("std of the semi-random hand motion across the push", "m", 0.0, 1.0),
+        metadata=param(
+            description="std of the semi-random hand motion across the push",
+            unit="m",
+            bounds=(0.0, 1.0),
+        ),
     )
 
     def __post_init__(self) -> None:

@@ -60,41 +60,61 @@ class SlideDeviceParams:
     """
 
     max_force_n: float = field(
-        default=4.0, metadata=param("actuator saturation (continuous force)", "N", 1e-3, 1e3)
+        default=4.0,
+        metadata=param(
+            description="actuator saturation (continuous force)", unit="N", bounds=(1e-3, 1e3)
+        ),
     )
     encoder_resolution_m: float = field(
-        default=1e-6, metadata=param("encoder resolution", "m", 1e-12, 1e-2)
+        default=1e-6,
+        metadata=param(description="encoder resolution", unit="m", bounds=(1e-12, 1e-2)),
     )
     initial_position_m: float = field(
-        default=0.0, metadata=param("slide position at start", "m", -1.0, 1.0)
+        default=0.0,
+        metadata=param(description="slide position at start", unit="m", bounds=(-1.0, 1.0)),
     )
     mass_kg: float = field(
-        default=SLIDE_MASS_KG, metadata=param("the plant's true moving mass", "kg", 1e-3, 100.0)
+        default=SLIDE_MASS_KG,
+        metadata=param(description="the plant's true moving mass", unit="kg", bounds=(1e-3, 100.0)),
     )
     viscous_n_s_per_m: float = field(
         default=SLIDE_VISCOUS_N_S_PER_M,
-        metadata=param("the plant's true viscous friction", "N s/m", 0.0, 1e3),
+        metadata=param(
+            description="the plant's true viscous friction", unit="N s/m", bounds=(0.0, 1e3)
+        ),
     )
     coulomb_n: float = field(
         default=SLIDE_COULOMB_N,
-        metadata=param("the plant's true Coulomb (sliding) friction", "N", 0.0, 100.0),
+        metadata=param(
+            description="the plant's true Coulomb (sliding) friction", unit="N", bounds=(0.0, 100.0)
+        ),
     )
     stiction_ratio: float = field(
         default=1.5,
-        metadata=param("static friction (breakaway) over the Coulomb level", "", 1.0, 10.0),
+        metadata=param(
+            description="static friction (breakaway) over the Coulomb level", bounds=(1.0, 10.0)
+        ),
     )
     stribeck_velocity_m_per_s: float = field(
         default=0.005,
-        metadata=param("speed over which friction falls from static to Coulomb", "m/s", 0.0, 1.0),
+        metadata=param(
+            description="speed over which friction falls from static to Coulomb",
+            unit="m/s",
+            bounds=(0.0, 1.0),
+        ),
     )
     amplifier_lag_s: float = field(
         default=5e-5,
-        metadata=param("time constant of the amplifier's current loop", "s", 0.0, 0.1),
+        metadata=param(
+            description="time constant of the amplifier's current loop", unit="s", bounds=(0.0, 0.1)
+        ),
     )
     encoder_noise_m: float = field(
         default=0.0,
         metadata=param(
-            "white noise on the position before the encoder counts (std)", "m", 0.0, 1e-2
+            description="white noise on the position before the encoder counts (std)",
+            unit="m",
+            bounds=(0.0, 1e-2),
         ),
     )
 

@@ -37,18 +37,27 @@ class LoopSettings:
     """Rate, physics sub-steps, length and seed of a simulated session."""
 
     rate_hz: float = field(
-        default=1000.0, metadata=param("control rate", "Hz", 1.0, 1e5, read_only=True)
+        default=1000.0,
+        metadata=param(description="control rate", unit="Hz", bounds=(1.0, 1e5), read_only=True),
     )
     substeps: int = field(
-        default=10, metadata=param("physics steps per control period", "", 1, 1000, read_only=True)
+        default=10,
+        metadata=param(
+            description="physics steps per control period", bounds=(1, 1000), read_only=True
+        ),
     )
     duration_s: float = field(
-        default=40.0, metadata=param("session length; 0 = until stopped", "s", 0.0, 1e7)
+        default=40.0,
+        metadata=param(
+            description="session length; 0 = until stopped", unit="s", bounds=(0.0, 1e7)
+        ),
     )
     seed: int = field(
         default=0,
         metadata=param(
-            "seed of the hand motion and sensor noise", "", 0, 2**31 - 1, read_only=True
+            description="seed of the hand motion and sensor noise",
+            bounds=(0, 2**31 - 1),
+            read_only=True,
         ),
     )
 
@@ -154,6 +163,7 @@ class SessionSummary:
     bandwidth_hz: float | None
     impedance_error_pct: float | None
     coherence_in_band: float | None
+    band_below_first_bin: bool = False  # the band ends below the first bin (a floor, not a value)
 
 
 @dataclass
@@ -219,6 +229,7 @@ class SessionResult:
             bandwidth_hz=None if tr is None else tr.bandwidth_hz,
             impedance_error_pct=None if tr is None else tr.impedance_error_pct,
             coherence_in_band=None if tr is None else tr.mean_coherence_in_band,
+            band_below_first_bin=False if tr is None else tr.band_below_first_bin,
         )
 
     def save(self, path: str | Path) -> None:

@@ -23,7 +23,10 @@ Protocol (linear in-contact onset, thesis 6.1 / theory sheet section 4):
 ``TAP`` is chapter 6's other protocol, for a loop that only a nonlinearity keeps quiet (DOB at
 Kf = 100 is linearly unstable at every wall): the same hand and push, the configuration's friction
 kept, and a tap of 3 N for 20 ms (the thesis's user tried to provoke vibration); a wall vibrates
-when the motion 2-3 s after the tap is larger than ``VIBRATION_RMS_M`` (``residual``).
+when the motion 2-3 s after the tap is one the hand feels (``felt``): its peak (``sqrt 2`` times
+the RMS about the slow trend, ``residual``) above the vibrotactile detection threshold at its
+dominant frequency (``detection_threshold_m``). The thesis's user judged "sustained vibrations"
+by feel (6.2), so the criterion is a perceptual one, not the encoder's resolution.
 
 Theory bound beside it: ``K (1 + Kf) < 2 b / T`` (Colgate & Schenkel; thesis 6.3 with Kf), i.e.
 2544 N/m open loop and 848 N/m for CL with Kf = 2 on the thesis's slide.
@@ -100,8 +103,30 @@ class StabilityProtocol:
 
 #: chapter 6's protocol for DOB at Kf = 100: the friction kept, a tap that breaks it
 TAP = StabilityProtocol(pulse_n=3.0, pulse_s=0.02, observe_s=3.0, coulomb_n=None)
-#: a wall vibrates when the motion 2-3 s after the tap exceeds this RMS (m)
-VIBRATION_RMS_M = 2e-6
+#: the vibrotactile detection threshold of the glabrous hand (peak displacement, m), after
+#: Bolanowski, Gescheider, Verrillo and Checkosky (1988), "Four channels mediate the mechanical
+#: aspects of touch", J. Acoust. Soc. Am. 84(5): the non-Pacinian I channel's plateau (about
+#: 26 dB re 1 um) up to 40 Hz; above it the Pacinian channel's U, falling 12 dB per octave to its
+#: minimum near 250 Hz and rising 9 dB per octave beyond (the slopes of Verrillo's curves)
+THRESHOLD_PLATEAU_M = 20e-6
+THRESHOLD_PLATEAU_HZ = 40.0
+THRESHOLD_MINIMUM_HZ = 250.0
+
+
+def detection_threshold_m(frequency_hz: float) -> float:
+    """The smallest vibration (peak displacement, m) a hand holding the handle detects at
+    ``frequency_hz`` (see ``THRESHOLD_PLATEAU_M``)."""
+    f = float(positive("frequency_hz", frequency_hz))
+    if f <= THRESHOLD_PLATEAU_HZ:
+        return THRESHOLD_PLATEAU_M
+    low = THRESHOLD_PLATEAU_M * (THRESHOLD_PLATEAU_HZ / min(f, THRESHOLD_MINIMUM_HZ)) ** 2
+    return float(low * (max(f, THRESHOLD_MINIMUM_HZ) / THRESHOLD_MINIMUM_HZ) ** 1.5)
+
+
+def felt(rms_m: float, frequency_hz: float) -> bool:
+    """True when a vibration of ``rms_m`` RMS at ``frequency_hz`` (a sinusoid: peak sqrt 2 times
+    the RMS) is above the hand's detection threshold."""
+    return math.sqrt(2.0) * rms_m > detection_threshold_m(frequency_hz)
 
 
 def residual(x: np.ndarray, rate_hz: float, start_s: float, end_s: float) -> tuple[float, float]:
@@ -258,11 +283,13 @@ def law_for(controller: str, kf: float, max_force_n: float = 4.0) -> ImpedanceLa
 
 __all__ = [
     "TAP",
-    "VIBRATION_RMS_M",
+    "THRESHOLD_PLATEAU_M",
     "ObserverSettings",
     "StabilityPoint",
     "StabilityProtocol",
     "StabilitySweep",
+    "detection_threshold_m",
+    "felt",
     "growth_at",
     "law_for",
     "onset",

@@ -1,25 +1,17 @@
 """A recorded teleoperation graph (``haptic-launch teleop_sim --record BAG``) as a
-``TeleopResult``: the arrays the batch runner fills, read from the bag's topics, and the
-session's config from the parameters the recorder took from every node. ``metrics()`` and the
-force-tracking figure are then the batch run's own code.
+``TeleopResult``: the batch runner's arrays from the bag's topics, the session's config from the
+parameters the recorder took from every node; ``metrics()`` and the figures are the batch run's.
 
-Where each array comes from (stamp k of both sides):
-
-- ``master_q``, ``master_qd``, ``slave_q``: ``/master`` and ``/slave`` ``joint_states``;
-  ``slave_command``: ``/slave/effort_command``;
-- ``master_point``: ``/master/ee_pose`` mapped to the slave (``mapped_point``, from both sides'
-  points at sample 0); ``slave_point``: ``/slave/ee_pose``; ``target``: ``/slave/pose_desired``;
-- ``contact``: ``/slave/sim/hand_wrench`` (the true contact force); ``estimate``:
-  ``/slave/wrench_estimate``; ``sensor``: ``/slave/wrench_measured``; ``rendered``:
-  ``/master/wrench_desired`` in slave units (``rendered_force``); ``hand``:
-  ``/master/sim/hand_wrench``;
-- the energy books, ``dissipated`` and ``silent``: the channel's messages, ``/teleop/to_slave``
-  (the master's port) and ``/teleop/to_master`` (the slave's), joints ``energy`` and ``silent``
-  (``haptic_dob.nodes.channel_node.to_wire``).
-
-A sample any topic lacks is left out (a lockstep recording has them all); a stamp sent twice (a
-lockstep re-send, the same values) counts once. Samples beyond the session's ``duration_s`` (the
-devices publish sample N after the last command) are left out, as the batch run has none.
+Arrays (stamp k of both sides): ``master_q``, ``master_qd``, ``slave_q``: ``/master`` and
+``/slave`` ``joint_states``; ``slave_command``: ``/slave/effort_command``; ``master_point``:
+``/master/ee_pose`` mapped to the slave (``mapped_point``, from both sides' points at sample 0);
+``slave_point``: ``/slave/ee_pose``; ``target``: ``/slave/pose_desired``; ``contact``, ``hand``:
+``/slave`` and ``/master`` ``sim/hand_wrench``; ``estimate``: ``/slave/wrench_estimate``;
+``sensor``: ``/slave/wrench_measured``; ``rendered``: ``/master/wrench_desired`` in slave units
+(``rendered_force``); ``dissipated`` and ``silent``: the channel's messages ``/teleop/to_slave``
+(the master's port) and ``/teleop/to_master`` (the slave's), joints ``energy`` and ``silent``.
+A sample some topic lacks is left out, a stamp sent twice counts once, and samples beyond the
+session's ``duration_s`` are left out. Why: docs/design/teleoperation.md.
 """
 
 from __future__ import annotations

@@ -1,21 +1,17 @@
 """What a teleoperation session gives: per-cycle arrays (``TeleopResult``) and its headline
 figures (``TeleopMetrics``).
 
-Contact means the true contact force is non-zero. Figures during contact:
-
-- ``estimate_error_pct``: RMS of the 3-D error of the slave observer's estimate against the true
-  contact force, in percent of the true force's RMS (``estimate_error_n``: in N);
-- ``force_tracking_error_pct``: the same for the force the master renders, scaled back to the
-  slave (``R F_w / force_scale``) at the same instant: the delay and the master's limits count.
-
-Outside contact: ``free_estimate_max_n``, the largest estimate while nothing touches (after
-``settle_s``), and ``position_error_mm``, the RMS distance from the slave's tool point (from its
-encoders: what the slave's ``ee_pose`` says) to the
-master's point mapped to the slave. Channel: ``channel_energy_min_j``, the lowest net energy
-the channel took in (``E_in`` minus ``E_out`` of both ports; below zero it has generated energy),
-``dissipated_j`` what the passivity controllers took out, and ``oscillation_mm``, the standard
-deviation of the master's point over the last second high-passed at 2 Hz, on its most moving
-axis (a loop that vibrates; the hand's own motion lies below).
+Contact: the true contact force is non-zero. In contact, ``estimate_error_pct`` is the RMS of the
+3-D error of the slave observer's estimate against the true contact force, in % of the true
+force's RMS (``estimate_error_n``: in N); ``force_tracking_error_pct`` the same for the force the
+master renders, scaled back to the slave (``R F_w / force_scale``) at the same instant. Outside
+contact: ``free_estimate_max_n``, the largest estimate after ``settle_s``; ``position_error_mm``,
+the RMS distance from the slave's tool point (its encoders' ``ee_pose``) to the master's point
+mapped to the slave. Channel: ``channel_energy_min_j``, the lowest net energy the channel took in
+(``E_in`` minus ``E_out`` of both ports; below zero it generated energy); ``dissipated_j``, what
+the passivity controllers took out; ``oscillation_mm``, the standard deviation of the master's
+point over the last second, high-passed at 2 Hz, on its most moving axis.
+What each figure tells: docs/design/teleoperation.md.
 """
 
 from __future__ import annotations

@@ -1,7 +1,6 @@
 """The slave arm alone, its joint impedance tracking a given path: free motion across the
-workspace (how large the estimate is with nothing in contact) and the excitation its joint
-friction is identified from (``haptic_dob.identification.arm_friction``, what ``haptic-identify
---urdf`` runs on a bag).
+workspace (how large the estimate is with nothing in contact). Its model is identified from the
+excitation ``haptic_sim.teleop.slave_model`` plays.
 
 The slave device, its observer and its controller are the teleoperation config's; no master and
 no channel: the point to track comes from ``path`` (m, at the sample's time in s).
@@ -17,15 +16,10 @@ from typing import Any
 import numpy as np
 
 from haptic_dob.core.cycle import estimate
-from haptic_dob.core.models._pinocchio import PinocchioModel
-from haptic_dob.core.models.factory import build_model
-from haptic_dob.identification.arm_friction import ArmFrictionFit, identify_arm_friction
 from haptic_dob.teleop.slave import SlaveController
 from haptic_sim.teleop.config import TeleopConfig
 
 Path = Callable[[float], tuple[float, float, float]]
-#: joint targets (rad) at a time (s), from the start posture: the identification's excitation
-JointPath = Callable[[float, np.ndarray], np.ndarray]
 
 
 @dataclass
@@ -83,20 +77,6 @@ def run_slave_path(config: TeleopConfig, path: Path, duration_s: float) -> Slave
     return _run(config, duration_s, step)
 
 
-def run_slave_joints(config: TeleopConfig, path: JointPath, duration_s: float) -> SlaveRun:
-    """The slave's joint impedance around the joint targets ``path(t, q_0)`` (rad)."""
-
-    def step(
-        ctl: SlaveController, q: np.ndarray, qd: np.ndarray, t: float
-    ) -> tuple[list[float], Any]:
-        if ctl.q_d is None:
-            ctl.start(q)
-        q_d = path(t, ctl.q_0)
-        return ctl.joint_command(q, qd, q_d), ctl.model._forward_kinematics(q_d)
-
-    return _run(config, duration_s, step)
-
-
 def sweep(
     start: tuple[float, float, float],
     reach_m: tuple[float, float, float],
@@ -115,51 +95,3 @@ def sweep(
         )
 
     return at
-
-
-def excitation(
-    amplitude_rad: float = 0.4, base_period_s: float = 2.0, ramp_s: float = 0.5
-) -> JointPath:
-    """Every joint swinging about the start posture, joint i with period ``base_period_s *
-    (1 + 0.29 i)`` (incommensurate: the joints' speeds decorrelate), ramped in."""
-
-    def at(t: float, q0: np.ndarray) -> np.ndarray:
-        r = 1.0 if t >= ramp_s else 0.5 - 0.5 * math.cos(math.pi * t / ramp_s)
-        periods = base_period_s * (1.0 + 0.29 * np.arange(q0.size))
-        out: np.ndarray = q0 + r * amplitude_rad * np.sin(2.0 * math.pi * t / periods)
-        return out
-
-    return at
-
-
-#: the low-pass (Hz) through which the slave's turn speeds are searched: its encoders resolve
-#: 1 urad a sample, speeds far below the 1.1 mrad/s its heaviest joint's friction turns over
-SLAVE_TURN_CUTOFF_HZ = 50.0
-
-
-def identify_slave_friction(
-    config: TeleopConfig, run: SlaveRun, holdout: float = 0.3
-) -> ArmFrictionFit:
-    """Each joint's viscous and Coulomb friction from a slave run's joint states (the effort
-    beyond the rigid body of the slave's URDF), as ``haptic-identify --urdf --turn-cutoff-hz
-    50`` fits a bag."""
-    rigid = _rigid_body(config)
-    return identify_arm_friction(
-        rigid,
-        run.stamps_ns,
-        run.q,
-        run.effort,
-        list(rigid.joint_names),
-        holdout=holdout,
-        turn_cutoff_hz=SLAVE_TURN_CUTOFF_HZ,
-    )
-
-
-def _rigid_body(config: TeleopConfig) -> PinocchioModel:
-    """The slave's URDF model without joint friction (the rigid body the fit starts from)."""
-    values = config.values("slave", "slave_controller_node")
-    values = {**values, "urdf.viscous_n_m_s_per_rad": [0.0], "urdf.coulomb_n_m": [0.0]}
-    model = build_model(values)
-    if not isinstance(model, PinocchioModel):
-        raise ValueError("the slave's friction is identified on a URDF model")
-    return model

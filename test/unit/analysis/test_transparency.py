@@ -7,6 +7,7 @@ import pytest
 from scipy.optimize import brentq
 
 from haptic_dob.analysis import band_edge, h1_impedance, mass_damper_band_edge_hz, transparency
+from haptic_dob.analysis.transparency import averages, segment_for
 
 FS = 1000.0
 
@@ -41,7 +42,7 @@ def exact_edge(K: float, m: float, b: float) -> float:
 def test_mass_damper_bandwidth_matches_the_formula(K: float) -> None:
     x, f = mass_damper_record(K, 0.416, 1.272)
     tr = transparency(x, f, FS, K)
-    # resolution: linear interpolation between 0.5 Hz bins of a curved |T| (worst at 80 N/m)
+    # resolution: linear interpolation between 0.25 Hz bins of a curved |T| (worst at 80 N/m)
     assert tr.bandwidth_hz == pytest.approx(exact_edge(K, 0.416, 1.272), rel=0.02, abs=0.06)
     # the damping-free formula of the theory sheet
     assert tr.bandwidth_hz == pytest.approx(mass_damper_band_edge_hz(K, 0.416), rel=0.03)
@@ -64,6 +65,30 @@ def test_perfect_spring_is_transparent_to_fmax() -> None:
     tr = transparency(x, f, FS, 800.0, fmax_hz=10.0)
     assert tr.band_limited_by_fmax and tr.bandwidth_hz == 10.0
     assert tr.impedance_error_pct < 0.5
+
+
+def test_a_band_that_ends_below_the_first_bin_is_flagged_not_measured() -> None:
+    """A wall rendered 6 dB soft from the lowest frequency on: the band ends somewhere below the
+    first bin (0.25 Hz with the default 4 s segments), which is a floor, not an edge; a record
+    whose first bin is inside is not flagged."""
+    x, f = mass_damper_record(800.0, 0.416, 1.272)
+    soft = transparency(x, 0.5 * f, FS, 800.0)
+    assert soft.segment_s == 4.0 and soft.freqs_hz[0] == pytest.approx(0.25)
+    assert soft.band_below_first_bin and soft.bandwidth_hz == pytest.approx(0.25)
+    assert not transparency(x, f, FS, 800.0).band_below_first_bin
+    coarse = transparency(x, 0.5 * f, FS, 800.0, segment_s=2.0)
+    assert coarse.band_below_first_bin and coarse.bandwidth_hz == pytest.approx(0.5)
+
+
+def test_the_default_segment_is_as_long_as_sixteen_averages_allow() -> None:
+    """4 s segments (0.25 Hz bins) where they average at least 16 (chapter 7's 38 s give 18),
+    else 2 s: an 18 s record (8 averages of 4 s) and anything shorter, down to one segment."""
+    assert averages(38.0, 4.0) == 18 and segment_for(38.0) == 4.0
+    assert segment_for(34.0) == 4.0 and segment_for(33.9) == 2.0
+    assert averages(18.0, 4.0) == 8 and segment_for(18.0) == 2.0
+    assert segment_for(2.25) == 2.0 and averages(1.8, 2.0) == 0
+    x, f = mass_damper_record(800.0, 0.416, 1.272, seconds=18.0)
+    assert transparency(x, f, FS, 800.0).segment_s == 2.0
 
 
 def test_band_edge_interpolates_linearly_in_magnitude() -> None:

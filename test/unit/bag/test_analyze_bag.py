@@ -58,8 +58,11 @@ def test_stiffness_option_overrides_the_recorded_one(msd_bag: Path) -> None:
     (seg,) = a.segments
     assert seg.stiffness_source == "--stiffness" and seg.stiffness_n_per_m == 1600.0
     assert seg.figures.transparency is not None
-    # against 1600 N/m the rendered 800 N/m is 6 dB low from the first bin: the band is empty
-    assert seg.figures.transparency.bandwidth_hz == pytest.approx(0.5)
+    # against 1600 N/m the rendered 800 N/m is 6 dB low from the first bin: the band ends below
+    # it (0.25 Hz with the 4 s segments)
+    tr = seg.figures.transparency
+    assert tr.bandwidth_hz == pytest.approx(0.25) and tr.band_below_first_bin
+    assert seg.as_dict()["band_below_first_bin"] is True
 
 
 def test_mode_switch_gives_two_labelled_segments(tmp_path: Path) -> None:

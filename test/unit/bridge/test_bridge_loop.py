@@ -3,12 +3,15 @@ out of it zero (the watchdogs, the dead-man, refused commands, the stop)."""
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import pytest
 
 from haptic_dob.bridge.driver_settings import DriverSettings
 from haptic_dob.bridge.loop import BridgeLoop
+from haptic_dob.bridge.report import bridge_status, write_stats
 from haptic_dob.bridge.settings import SafetySettings
 from haptic_dob.bridge.state import DriverState
 from haptic_dob.core.models.point_mass import PointMassModel
@@ -157,3 +160,30 @@ def test_states_whose_stamps_do_not_advance_are_said_once_and_counted() -> None:
         assert b.on_state(state(0), 0.0) == (None, None)
     assert b.counts()["states_not_advancing"] == 3
     assert len([s for s in said if "do not advance" in s]) == 1
+
+
+def test_the_status_says_why_the_driver_gets_zero_before_asking_of_foreign_commands() -> None:
+    b = bridge()
+    asked: list[bool] = []
+
+    def foreign() -> bool:
+        asked.append(True)
+        return True
+
+    status = bridge_status(b, {"command_authority": "controller_node"}, foreign)
+    assert status.warning and status.message == "waiting for the loop: zero command"
+    assert status.values["command_authority"] == "controller_node" and not asked
+    assert status.values["on_time_pct"] == "nan" and status.values["states"] == 0
+    b.start()
+    b.on_state(state(1), 0.0)
+    b.on_command(cmd(1), 0.0)
+    status = bridge_status(b, {}, foreign)
+    assert status.message == "refused commands from a publisher not the loop's" and asked
+    assert not bridge_status(b, {}, lambda: False).warning
+
+
+def test_the_stats_file_writes_nothing_measured_as_null(tmp_path: Path) -> None:
+    path = tmp_path / "stats.json"
+    write_stats(str(path), bridge().counts())
+    written = json.loads(path.read_text())
+    assert written["on_time_pct"] is None and written["states"] == 0

@@ -67,3 +67,14 @@ def test_every_parameter_is_described_and_structural_ones_are_read_only() -> Non
     } <= set(specs)
     assert all(s.description for s in specs.values())
     assert specs["safety.rate_limit"].unit == "N/s" and specs["state.topic"].read_only
+
+
+def test_the_drivers_topics_must_not_be_the_loops_own() -> None:
+    driver = DriverSettings.of({"state.topic": "joint_states", "command.topic": "/fd/cmd"})
+    with pytest.raises(ValueError, match="the driver's joint_states is the loop's own topic"):
+        driver.check_apart(lambda t: t if t.startswith("/") else f"/{t}")
+    DriverSettings.of(FD).check_apart(lambda t: t if t.startswith("/") else f"/haptic/{t}")
+    assert DriverSettings.of(FD).describe() == (
+        "a ros2_control_effort driver: state /fd/joint_states (joint_states, reliable), "
+        "command /fd/fd_controller/commands (float64_multi_array, reliable)"
+    )

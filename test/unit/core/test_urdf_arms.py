@@ -1,7 +1,7 @@
 """Real arms' URDFs: continuous, mimic and fixed joints, grippers, meshes; a known tip force.
 
 ``config/urdf/arm6_gripper.urdf`` (ours, always run) holds what real descriptions hold. Third-party
-arms come from the ``example-robot-data`` package (``pip install -e '.[arms]'``), skipped with a
+arms come from the ``example-robot-data`` package (``support.published_arms``), skipped with a
 reason when it is absent. The known-force checks run the arm in ``armsim.AbaArm``, a simulator
 of the tests' own (articulated-body algorithm, a spatial force on the tip's body, integration on
 pinocchio's configuration), not the observer's model run backwards.
@@ -10,7 +10,6 @@ pinocchio's configuration), not the observer's model run backwards.
 from __future__ import annotations
 
 import math
-from importlib import metadata
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +20,7 @@ from haptic_dob.core.models import UrdfModel
 from haptic_dob.core.models.factory import build_model
 from haptic_dob.core.observers.disturbance import DisturbanceObserver
 from support.armsim import AbaArm
+from support.published_arms import ARMS, ROBOTS, SKIP_REASON
 
 ROOT = Path(__file__).resolve().parents[3]
 ARM6 = ROOT / "config" / "urdf" / "arm6_gripper.urdf"
@@ -206,43 +206,7 @@ def test_observer_recovers_a_known_tip_force_on_arm6(tip: str, swing_rad: float)
     assert err < 0.02 * np.linalg.norm(FORCE), err
 
 
-def example_robot_data() -> Path | None:
-    """The ``robots`` folder of the example-robot-data package, when installed."""
-    try:
-        dist = metadata.distribution("example-robot-data")
-    except metadata.PackageNotFoundError:
-        return None
-    path = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
-    return path if path.is_dir() else None
-
-
-ROBOTS = example_robot_data()
-#: third-party arms: (URDF under robots/, tip frame, a start posture away from singularities)
-ARMS = {
-    "panda": (
-        "panda_description/urdf/panda.urdf",
-        "panda_hand_tcp",
-        [0.2, -0.6, 0.1, -2.0, 0.1, 1.6, 0.8],
-    ),
-    "ur5": ("ur_description/urdf/ur5_robot.urdf", "tool0", [0.3, -1.2, 1.4, -1.6, -1.5, 0.2]),
-    "z1": ("z1_description/urdf/z1.urdf", "gripperStator", [0.2, 1.0, -1.2, 0.3, 0.2, 0.1]),
-    "kinova": (
-        "kinova_description/robots/kinova.urdf",
-        "j2s6s200_end_effector",
-        [0.3, 3.4, 1.2, 0.5, 1.0, 0.2],
-    ),
-    "talos_arm": (
-        "talos_data/robots/talos_left_arm.urdf",
-        "gripper_left_base_link",
-        [1.0, 1.1, 1.5, -1.0, -1.4, 0.1],
-    ),
-    "xarm7": ("xarm_description/urdf/xarm7.urdf", "link_eef", [0.1, -0.5, 0.1, 0.8, 0.1, 1.2, 0.1]),
-}
-
-
-@pytest.mark.skipif(
-    ROBOTS is None, reason="example-robot-data not installed (pip install -e '.[arms]')"
-)
+@pytest.mark.skipif(ROBOTS is None, reason=SKIP_REASON)
 @pytest.mark.parametrize("arm", sorted(ARMS))
 @pytest.mark.parametrize("swing_rad", [0.0, 0.15], ids=["held", "moving"])
 def test_observer_recovers_a_known_tip_force_on_third_party_arms(

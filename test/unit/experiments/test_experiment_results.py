@@ -17,6 +17,7 @@ from haptic_sim.experiments import (
     observer_vs_sensor,
     report,
     results,
+    slave_model,
     spread,
     sweeps,
 )
@@ -30,7 +31,7 @@ from haptic_sim.experiments.parts import (
     save_results,
 )
 from haptic_sim.experiments.phantom import PhantomResult, PhantomWallCell
-from haptic_sim.experiments.records import Cell, ExperimentResults, RunAnalysis
+from haptic_sim.experiments.records import Cell, Check, ExperimentResults, RunAnalysis
 from haptic_sim.experiments.stability_map import MapPoint, StabilityMap
 from haptic_sim.slide.session import SessionConfig
 
@@ -53,7 +54,7 @@ def _every_part() -> dict[str, object]:
         _run("ch6", "OL", 0.0, 2800.0, perturbation_growth_per_s=None, perturbation_vibrates=True),
     ]
     kick = [
-        dob_mechanism.KickPoint(w, 7.0, 0.24, 1e-5 * w / 4000.0, 30.0) for w in dob_mechanism.WALLS
+        dob_mechanism.KickPoint(w, 7.0, 0.24, 1e-4 * w / 4000.0, 30.0) for w in dob_mechanism.WALLS
     ]
     fits = [
         SlideFit("least_squares", "slide", 0.42, 1.25, 0.245, 1e-3, 0.02, 4e-3, 900, 0.01),
@@ -122,6 +123,31 @@ def _every_part() -> dict[str, object]:
         ),
         "phantom": PhantomResult(
             [0.0, 0.012, 0.004], [0.0, 0.95, 0.49], [PhantomWallCell(1.0, 0.3, 8e-5, 0.008)]
+        ),
+        "slave": slave_model.SlaveModelResult(
+            60.0,
+            1676,
+            8.05,
+            "runs/slave_excitation/identified.urdf",
+            ["joint1"],
+            [0.06],
+            [9.9],
+            [0.12],
+            [0.45],
+            [1.32],
+            [0.116],
+            [0.446],
+            [1.324],
+            ["link1"],
+            [4.0],
+            [4.0],
+            ["link1.m"],
+            [
+                slave_model.ModelRow("CAD", 6.1, 5.0, 32.6, [1.7, 2.2]),
+                slave_model.ModelRow("identified", 0.027, 0.009, 0.07, [0.006, 0.015]),
+            ],
+            [Check("held-out residual", True)],
+            [],
         ),
     }
 
@@ -212,7 +238,7 @@ def test_a_run_analysis_takes_haptic_analyze_figures_by_name() -> None:
 
 
 def test_the_table_names_each_part_and_figure_once() -> None:
-    assert len(set(PARTS)) == len(PARTS) == 8 and QUICK_PARTS == ["ch7"]
+    assert len(set(PARTS)) == len(PARTS) == 9 and QUICK_PARTS == ["ch7"]
     files = [f.file for e in EXPERIMENTS for f in e.figures]
     assert len(set(files)) == len(files)
 

@@ -34,7 +34,10 @@ def test_each_node_gets_its_sections_from_the_general_to_the_specific(sections, 
     assert master["model"] == "slide" and slave["model"] == "urdf"  # /<ns>/**
     assert master["duration_s"] == slave["duration_s"] == 6.0  # /**/device_node
     assert master["rate_hz"] == 1000.0  # /**
-    assert slave["urdf_path"] == str(root / "config" / "urdf" / "arm7.urdf")  # beside the YAML
+    urdf = root / "config" / "urdf"
+    assert slave["urdf_path"] == str(urdf / "arm7_truth.urdf")  # beside the YAML
+    assert params["slave/observer_node"]["urdf_path"] == str(urdf / "arm7_identified.urdf")
+    assert params["slave/slave_controller_node"]["urdf_path"] == str(urdf / "arm7.urdf")  # /<ns>/**
     assert params["master/channel_node"]["role"] == "master"
     assert params["slave/channel_node"]["channel.round_trip_delay_ms"] == 2.0
 

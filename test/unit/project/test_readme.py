@@ -45,8 +45,9 @@ def anchors(path: Path) -> set[str]:
 
 
 def markdown_files() -> list[Path]:
-    """README.md and every page under docs/."""
-    return [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    """README.md, every guide under docs/ and every design page under docs/design/."""
+    docs = ROOT / "docs"
+    return [ROOT / "README.md", *sorted(docs.glob("*.md")), *sorted((docs / "design").glob("*.md"))]
 
 
 def test_core_example_prints_what_the_readme_shows(tmp_path: Path) -> None:
@@ -86,8 +87,15 @@ def test_every_relative_link_points_to_an_existing_file_and_heading() -> None:
 def test_the_readme_links_every_docs_page() -> None:
     readme = prose((ROOT / "README.md").read_text(encoding="utf-8"))
     linked = {t.partition("#")[0] for t in LINK.findall(readme)}
-    pages = {f"docs/{p.name}" for p in markdown_files()[1:]}
+    pages = {f"docs/{p.name}" for p in sorted((ROOT / "docs").glob("*.md"))}
     assert pages - linked == set()
+
+
+def test_the_development_guide_links_every_design_page() -> None:
+    guide = ROOT / "docs" / "development.md"
+    linked = {t.partition("#")[0] for t in LINK.findall(prose(guide.read_text(encoding="utf-8")))}
+    pages = {f"design/{p.name}" for p in sorted((ROOT / "docs" / "design").glob("*.md"))}
+    assert pages and pages - linked == set()
 
 
 def test_slugs_follow_github() -> None:

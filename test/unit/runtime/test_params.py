@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+from typing import Any
+
 import pytest
 
 from haptic_dob.core.control import ImpedanceLaw
 from haptic_dob.core.environment import VirtualWall
-from haptic_dob.runtime.params import ParamSpec, build, specs_of, values_of
+from haptic_dob.runtime.params import ParamSpec, build, param, specs_of, values_of
 from haptic_sim.hand import HandParams
 
 
@@ -62,3 +65,60 @@ def test_a_range_declared_for_an_array_holds_for_each_element() -> None:
     assert spec.check([0.1, 0.2]) is None
     assert spec.check([0.1, -0.2]) == "urdf.coulomb_n_m must be >= 0 N m, got -0.2"
     assert spec.check([2000.0]) == "urdf.coulomb_n_m must be <= 1000 N m, got 2000"
+
+
+@dataclass(frozen=True)
+class _Group:
+    """A settings group as the nodes declare one."""
+
+    gain: float = field(
+        default=1.0,
+        metadata=param(
+            description="a gain", unit="N/m", bounds=(0.0, 10.0), details="Only the docs say so."
+        ),
+    )
+    floor: float = field(default=0.0, metadata=param(description="a floor", bounds=(-1.0, None)))
+    mode: str = field(
+        default="a", metadata=param(description="a mode", choices=("a", "b"), read_only=True)
+    )
+    cpus: list[int] | tuple[int, ...] = field(
+        default_factory=list, metadata=param(description="CPUs")
+    )
+    names: list[str] | tuple[str, ...] = field(
+        default_factory=list, metadata=param(description="names")
+    )
+    scale: list[float] | tuple[float, ...] = field(
+        default_factory=list, metadata=param(description="scales")
+    )
+
+
+def test_param_is_keyword_only() -> None:
+    old_form: Any = param  # the old positional form, out of the converter's and mypy's sight
+    with pytest.raises(TypeError):
+        old_form("a gain", "N/m", 0.0, 10.0)
+
+
+def test_a_row_carries_bounds_details_and_its_one_line_description() -> None:
+    gain, floor, mode, *_ = specs_of(_Group, "g.")
+    assert (gain.name, gain.min, gain.max, gain.unit) == ("g.gain", 0.0, 10.0, "N/m")
+    assert gain.details == "Only the docs say so."
+    assert gain.full_description() == "a gain [N/m]"  # what ros2 param describe shows
+    assert (floor.min, floor.max) == (-1.0, None)
+    assert floor.check(-2.0) == "g.floor must be >= -1, got -2"
+    assert mode.read_only and mode.full_description() == "a mode one of: a, b"
+
+
+def test_an_empty_array_takes_its_element_type_from_the_annotation() -> None:
+    rows = {s.name: s for s in specs_of(_Group)}
+    assert rows["cpus"].item_kind is int
+    assert rows["names"].item_kind is str
+    assert rows["scale"].item_kind is float
+
+
+def test_a_node_overrides_a_groups_default_and_heads_its_descriptions() -> None:
+    rows = specs_of(_Group, "x.", defaults={"mode": "b"}, about="the other use")
+    assert [s.default for s in rows[:3]] == [1.0, 0.0, "b"]
+    assert rows[0].description == "the other use: a gain"
+    assert specs_of(_Group)[2].default == "a"  # the dataclass keeps its own default
+    with pytest.raises(TypeError, match="no parameter nope"):
+        specs_of(_Group, defaults={"nope": 1})

@@ -17,6 +17,7 @@ from haptic_sim.device.cycle_stats import RealtimeStats
 from haptic_sim.device.factory import build_device
 from haptic_sim.device.loop import STARTUP_RESEND_S, DeviceLoop
 from haptic_sim.device.recorder_gate import Drain, RecorderGate
+from haptic_sim.device.report import device_status
 from haptic_sim.device.sample import DeviceSample
 from haptic_sim.device.settings import device_node_specs
 
@@ -440,3 +441,33 @@ def test_start_with_names_devices_fully_qualified_and_waits_for_their_joint_stat
     for bad in ("slave/device_node", "device_node", "/slave/"):
         with pytest.raises(ValueError, match="fully qualified"):
             start_topics([bad])
+
+
+# --- what the node reports ---------------------------------------------------------------------
+def test_the_status_warns_of_the_worst_first_and_asks_of_foreign_commands_only_then() -> None:
+    loop, _port, _log = make_loop(lockstep=True)
+    asked: list[bool] = []
+
+    def foreign() -> bool:
+        asked.append(True)
+        return True
+
+    status = device_status(loop, {"command_authority": "controller_node"}, foreign)
+    assert status.warning and "publishers other than the loop's" in status.message
+    assert status.values["clock_mode"] == "lockstep" and "overruns" not in status.values
+    assert status.values["command_authority"] == "controller_node" and asked == [True]
+    loop, _port, _log = started(lockstep=True)
+    command(loop, math.nan)
+    status = device_status(loop, {}, foreign)
+    assert status.message == "refusing invalid effort_command (zero effort)"
+    assert asked == [True]  # the foreign commands' news waits for the next report
+    loop, _port, _log = started(lockstep=False, wait_for=[])
+    status = device_status(loop, {}, lambda: False)
+    assert not status.warning and status.message == "running" and status.values["overruns"] == 0
+
+
+def test_the_stats_file_holds_the_statistics_nan_before_a_command(tmp_path: Any) -> None:
+    path = tmp_path / "stats.json"
+    RealtimeStats().result(0, 0, 0, 0).write(str(path))
+    written = json.loads(path.read_text())
+    assert next(iter(written)) == "cycles" and math.isnan(written["on_time_pct"])

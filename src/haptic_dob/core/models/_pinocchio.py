@@ -102,6 +102,9 @@ class PinocchioModel(DeviceModel):
             friction is ``b q' + Fc sgn(q')``.
         coulomb_speed: v_c (rad/s or m/s), scalar or per joint, >= 0: where > 0 the Coulomb
             term is ``Fc tanh(q' / v_c)`` (a friction that turns over a speed, as identified).
+        armature: rotor inertia reflected to each joint (kg m^2 or kg), scalar or per joint,
+            >= 0: added to D's diagonal (pinocchio's ``armature``; ``S`` must then be a
+            permutation).
     """
 
     def __init__(
@@ -115,6 +118,7 @@ class PinocchioModel(DeviceModel):
         viscous: float | Sequence[float] = 0.0,
         coulomb: float | Sequence[float] = 0.0,
         coulomb_speed: float | Sequence[float] = 0.0,
+        armature: float | Sequence[float] = 0.0,
     ) -> None:
         self.dof = len(joint_names)
         self.joint_names = tuple(joint_names)
@@ -152,6 +156,13 @@ class PinocchioModel(DeviceModel):
         speed = np.where(self._smooth, self.coulomb_speed, 1.0)
         self._inv_speed = np.where(self._smooth, 1.0 / speed, 0.0)
         self._any_smooth = bool(np.any(self._smooth & (self.coulomb > 0.0)))
+        self.armature = self._per_joint("armature", armature)
+        if S is None:
+            model.armature[:] = self.armature
+        elif np.any(self.armature > 0.0):
+            if not np.array_equal(S @ S.T, np.eye(model.nv)):
+                raise ValueError("armature needs one pinocchio joint per coordinate")
+            model.armature[:] = S @ self.armature
 
     def _per_joint(self, name: str, value: float | Sequence[float]) -> Vec:
         """A scalar for every joint, or one value per joint; finite and >= 0."""

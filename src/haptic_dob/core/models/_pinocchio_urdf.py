@@ -1,25 +1,25 @@
 """URDF arms for pinocchio: parse, choose the joints, lock the rest (pinocchio's API stays here).
 
-What a real arm's description holds and how it is used:
-
 - revolute and prismatic joints: one coordinate each;
-- continuous joints (pinocchio's ``RUB`` joints, configuration ``(cos, sin)``): one coordinate,
-  the angle, as a joint state carries it (``PinocchioModel`` maps angles to pinocchio's
-  configuration with ``pinocchio.integrate`` from the neutral configuration);
-- mimic joints (a gripper's second finger): pinocchio's own mimic joints, which follow their
-  master; they are never coordinates of their own, and move with their master when it is chosen
-  (else they are locked with it);
-- fixed joints: merged into their links by the parser;
-- meshes (``package://``, relative paths): never read (dynamics need none);
+- continuous joints (pinocchio's ``RUB``, configuration ``(cos, sin)``): one coordinate, the
+  angle as a joint state carries it (``PinocchioModel`` maps angles to the configuration with
+  ``pinocchio.integrate`` from the neutral configuration);
+- mimic joints: pinocchio's own, following their master, never coordinates of their own (they
+  move with their master when it is chosen, else they are locked with it);
+- fixed joints: merged into their links; meshes: never read;
 - floating, planar and other multi-DOF joints: refused with the joint's name when they would be
-  a coordinate (leave them out of ``joint_names`` to lock them).
+  a coordinate (left out of ``joint_names`` they are locked);
+- ``<dynamics damping friction>``: joint friction; a joint's armature and Coulomb turn in its
+  ``<haptic_dob:dynamics armature=".." coulomb_speed=".."/>`` (``URDF_NAMESPACE``).
 
-Every joint that is not chosen is locked at its neutral position (zero angle or offset).
+Every joint that is not chosen is locked at its neutral position (zero angle or offset). What a
+real arm's description holds and how it is used: docs/models.md, "PHANToM 1.5 and URDF arms".
 """
 
 from __future__ import annotations
 
 import math
+import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +31,10 @@ _MIMIC = "JointModelMimic"
 _MULTI_DOF = {"JointModelFreeFlyer": "floating", "JointModelPlanar": "planar"}
 _FT = pin.FrameType
 _FRAME_PREFERENCE = (_FT.BODY, _FT.OP_FRAME, _FT.FIXED_JOINT, _FT.JOINT, _FT.SENSOR)
+#: the XML namespace of what the suite adds to a URDF (``xmlns:haptic_dob="..."`` on <robot>)
+URDF_NAMESPACE = "urn:haptic-dob:urdf"
+#: the element of a <joint> holding its armature and Coulomb turn (attributes, SI units)
+EXTRA_DYNAMICS = f"{{{URDF_NAMESPACE}}}dynamics"
 
 
 @dataclass(frozen=True)
@@ -44,6 +48,11 @@ class UrdfArm:
     effort_limits: tuple[float, ...]  # from the URDF's <limit effort>, N m or N (0 = none)
     damping: tuple[float, ...]  # <dynamics damping>: viscous friction, N m s/rad or N s/m
     friction: tuple[float, ...]  # <dynamics friction>: Coulomb friction, N m or N
+    armature: tuple[float, ...] = ()  # <haptic_dob:dynamics armature>: kg m^2 or kg (0 = none)
+    coulomb_speed: tuple[float, ...] = ()  # <haptic_dob:dynamics coulomb_speed>: rad/s or m/s
+    # <limit lower upper>: rad or m (-inf, inf for a continuous joint); <limit velocity> (0: none)
+    position_limits: tuple[tuple[float, float], ...] = ()
+    velocity_limits: tuple[float, ...] = ()
 
 
 def read_urdf(urdf: str | Path) -> str:
@@ -153,7 +162,55 @@ def urdf_model(
     limits = tuple(v if math.isfinite(v) and v > 0.0 else 0.0 for v in limits)
     damping = tuple(float(model.damping[i]) for i in idx_v)
     friction = tuple(float(model.friction[i]) for i in idx_v)
-    return UrdfArm(model, frame_id(model, tip_frame), tuple(wanted), S, limits, damping, friction)
+    extra = extra_dynamics(xml)
+    armature = tuple(extra.get(n, {}).get("armature", 0.0) for n in wanted)
+    speed = tuple(extra.get(n, {}).get("coulomb_speed", 0.0) for n in wanted)
+    fid = frame_id(model, tip_frame)
+    ranges = tuple(_range(model, n) for n in wanted)
+    speeds = tuple(_finite(float(model.velocityLimit[i])) for i in idx_v)
+    return UrdfArm(
+        model, fid, tuple(wanted), S, limits, damping, friction, armature, speed, ranges, speeds
+    )
+
+
+def _finite(value: float) -> float:
+    return value if math.isfinite(value) and value > 0.0 else 0.0
+
+
+def _range(model: pin.Model, name: str) -> tuple[float, float]:
+    """A joint's position limits; (-inf, inf) for a continuous joint (configuration (cos, sin))."""
+    jm = model.joints[model.getJointId(name)]
+    if jm.nq != 1:
+        return (-math.inf, math.inf)
+    lo, hi = float(model.lowerPositionLimit[jm.idx_q]), float(model.upperPositionLimit[jm.idx_q])
+    return (lo, hi) if lo < hi else (-math.inf, math.inf)
+
+
+def extra_dynamics(xml: str) -> dict[str, dict[str, float]]:
+    """Joint name -> the attributes of its ``<haptic_dob:dynamics>`` (armature, coulomb_speed),
+    each finite and >= 0; ``ValueError`` naming the joint otherwise."""
+    if URDF_NAMESPACE not in xml:
+        return {}
+    out: dict[str, dict[str, float]] = {}
+    for joint in ET.fromstring(xml).findall("joint"):
+        element = joint.find(EXTRA_DYNAMICS)
+        if element is None:
+            continue
+        name = joint.get("name", "")
+        values = {}
+        for key in ("armature", "coulomb_speed"):
+            text = element.get(key)
+            if text is None:
+                continue
+            try:
+                value = float(text)
+            except ValueError:
+                value = math.nan
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ValueError(f"urdf: joint {name}: {key} must be a number >= 0, got {text!r}")
+            values[key] = value
+        out[name] = values
+    return out
 
 
 def add_payload(model: pin.Model, frame: int, mass_kg: float) -> None:

@@ -6,7 +6,8 @@
 - ``phantom``: ``phantom.params`` (``appendix_b`` | ``cavusoglu``), ``phantom.gravity``,
   ``phantom.viscous_n_m_s_per_rad`` (``PhantomSettings``).
 - ``urdf``: ``robot_description`` (URDF text, the ROS convention) or ``urdf_path``, ``tip_frame``,
-  ``joint_names``, plus ``urdf.gravity``, ``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``.
+  ``joint_names``, plus ``urdf.gravity``, ``urdf.viscous_n_m_s_per_rad``, ``urdf.coulomb_n_m``,
+  ``urdf.coulomb_speed_rad_per_s`` and ``urdf.armature_kg_m2``.
 
 All of them are structural, so read-only.
 """
@@ -14,6 +15,7 @@ All of them are structural, so read-only.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass, field
 from typing import Any
 
 from haptic_dob.core.models.base import DeviceModel
@@ -21,15 +23,25 @@ from haptic_dob.core.models.phantom import PhantomSettings
 from haptic_dob.core.models.point_mass import PointMassParams
 from haptic_dob.core.models.slide import SlideParams
 from haptic_dob.core.models.urdf import UrdfOptions, UrdfSettings
-from haptic_dob.runtime.params import ParamSpec, build, specs_of
+from haptic_dob.runtime.params import ParamSpec, build, param, specs_of
 
 MODEL_KINDS = ("slide", "point_mass", "phantom", "urdf")
+
+
+@dataclass(frozen=True)
+class ModelChoice:
+    """Which device model (``model``); its group holds its settings."""
+
+    model: str = field(
+        default="slide",
+        metadata=param(description="device model", choices=MODEL_KINDS, read_only=True),
+    )
 
 
 def model_specs() -> list[ParamSpec]:
     """The structural (read-only) parameters that choose and define the device model."""
     return [
-        ParamSpec("model", "slide", "device model", choices=MODEL_KINDS, read_only=True),
+        *specs_of(ModelChoice),
         *specs_of(SlideParams, "slide.", read_only=True),
         *specs_of(PointMassParams, "point_mass.", read_only=True),
         *specs_of(PhantomSettings, "phantom.", read_only=True),

@@ -1,28 +1,16 @@
 """The PHANToM 1.5 (thesis appendix B; theory.md section 5), computed with pinocchio.
 
-Joints ``q = [phi1, phi2, phi3]`` (rad): phi1 base yaw about the vertical z axis, phi2 absolute
-elevation of link 1 (upper arm), phi3 absolute elevation of link 2 (crank); both elevations are
-driven at the base. Link 3 stays parallel to link 1 and link 4 (forearm) parallel to link 2, so the
-forearm points along ``-(cos phi3, sin phi3)`` in the arm's vertical plane. Base frame: z up,
-origin where the three joint axes meet. End-effector point at ``le4`` from the elbow::
+Joints ``q = [phi1, phi2, phi3]`` (rad): phi1 base yaw about the vertical z axis, phi2 and phi3
+the absolute elevations of link 1 (upper arm) and link 2 (crank), both driven at the base. Base
+frame: z up, origin where the three joint axes meet. End-effector point at ``le4`` from the elbow::
 
     r = l1 cos phi2 - le4 cos phi3,   p = [r cos phi1, r sin phi1, l1 sin phi2 - le4 sin phi3]
 
-``HOME = (0, 0, pi/2)``: upper arm horizontal, forearm hanging straight down.
-
-The parallelogram's loop closure is linear in the angles, so the dynamics are those of an open
-tree with ``q_t = S q = [q1, q2, q3 - q2, q3, q2 - q3]`` (branch 1: phi2 -> link 1 -> elbow hinge
--> link 4; branch 2: phi3 -> link 2 -> hinge -> link 3), computed by pinocchio:
-``D = S^T crba S``, ``C q' + G = S^T rnea(S q, S q', 0)``, ``J = J_t S``.
-
-Parameter sets (``PHANTOM_PARAMS``):
-
-- ``appendix_b``: the thesis's Table B.1 (links as thin bodies: inertia ``I`` about the two axes
-  across the link, none along it, so the closed form of theory.md section 5 holds exactly).
-- ``cavusoglu``: Cavusoglu, Feygin and Tendick (2002), the real PHANToM 1.5, converted to this
-  convention (their y-up frame, ``theta3 = phi3 - pi/2``): upper-arm body ``be`` and crank body
-  ``df`` with their published inertias about the joint axes (their masses at l5, l6 only in
-  gravity, as in the paper's model), forearm ``a`` and lower link ``c`` as rods at half length.
+``HOME = (0, 0, pi/2)``: upper arm horizontal, forearm hanging straight down. Dynamics of the
+open tree ``q_t = S q = [q1, q2, q3 - q2, q3, q2 - q3]`` by pinocchio: ``D = S^T crba S``,
+``C q' + G = S^T rnea(S q, S q', 0)``, ``J = J_t S``. Parameter sets (``PHANTOM_PARAMS``):
+``appendix_b`` (Table B.1, links as thin bodies) and ``cavusoglu`` (Cavusoglu, Feygin and
+Tendick 2002, the real PHANToM 1.5). The tree and the conversions: docs/design/arms.md.
 """
 
 from __future__ import annotations
@@ -221,16 +209,21 @@ class PhantomSettings:
     params: str = field(
         default="appendix_b",
         metadata=param(
-            "PHANToM 1.5 parameter set: thesis Table B.1 or Cavusoglu-Feygin-Tendick 2002",
+            description=(
+                "PHANToM 1.5 parameter set: thesis Table B.1 or Cavusoglu-Feygin-Tendick 2002"
+            ),
             choices=tuple(PHANTOM_PARAMS),
         ),
     )
     gravity: bool = field(
         default=True,
-        metadata=param("include gravity in the model (false: an observer that leaves G out)"),
+        metadata=param(
+            description="include gravity in the model (false: an observer that leaves G out)"
+        ),
     )
     viscous_n_m_s_per_rad: float = field(
-        default=0.0, metadata=param("viscous joint friction", "N m s/rad", 0.0, 10.0)
+        default=0.0,
+        metadata=param(description="viscous joint friction", unit="N m s/rad", bounds=(0.0, 10.0)),
     )
 
     def model(self) -> PhantomModel:

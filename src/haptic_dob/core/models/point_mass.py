@@ -112,19 +112,25 @@ class PointMassParams:
 
     mass_kg: tuple[float, float, float] = field(
         default=(0.2, 0.2, 0.2),
-        metadata=param("moving mass per axis (x, y, z)", "kg", 1e-3, 100.0),
+        metadata=param(
+            description="moving mass per axis (x, y, z)", unit="kg", bounds=(1e-3, 100.0)
+        ),
     )
     viscous_n_s_per_m: tuple[float, float, float] = field(
         default=(0.0, 0.0, 0.0),
-        metadata=param("viscous friction per axis (x, y, z)", "N s/m", 0.0, 1e3),
+        metadata=param(
+            description="viscous friction per axis (x, y, z)", unit="N s/m", bounds=(0.0, 1e3)
+        ),
     )
     coulomb_n: tuple[float, float, float] = field(
         default=(0.0, 0.0, 0.0),
-        metadata=param("Coulomb friction per axis (x, y, z)", "N", 0.0, 100.0),
+        metadata=param(
+            description="Coulomb friction per axis (x, y, z)", unit="N", bounds=(0.0, 100.0)
+        ),
     )
     joint_names: tuple[str, str, str] = field(
         default=FD_JOINTS,
-        metadata=param("the axes' joint names in joint_states (x, y, z)"),
+        metadata=param(description="the axes' joint names in joint_states (x, y, z)"),
     )
 
     def model(self) -> PointMassModel:

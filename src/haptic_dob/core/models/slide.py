@@ -84,18 +84,22 @@ class SlideParams:
     """Settings of a ``SlideModel`` (defaults: the thesis's identified slide)."""
 
     mass_kg: float = field(
-        default=SLIDE_MASS_KG, metadata=param("moving mass of the slide", "kg", 1e-3, 100.0)
+        default=SLIDE_MASS_KG,
+        metadata=param(description="moving mass of the slide", unit="kg", bounds=(1e-3, 100.0)),
     )
     viscous_n_s_per_m: float = field(
         default=SLIDE_VISCOUS_N_S_PER_M,
-        metadata=param("viscous friction of the slide", "N s/m", 0.0, 1e3),
+        metadata=param(
+            description="viscous friction of the slide", unit="N s/m", bounds=(0.0, 1e3)
+        ),
     )
     coulomb_n: float = field(
-        default=SLIDE_COULOMB_N, metadata=param("Coulomb friction of the slide", "N", 0.0, 100.0)
+        default=SLIDE_COULOMB_N,
+        metadata=param(description="Coulomb friction of the slide", unit="N", bounds=(0.0, 100.0)),
     )
     axis: tuple[float, float, float] = field(
         default=(1.0, 0.0, 0.0),
-        metadata=param("slide direction in the base frame (unit 3-vector)"),
+        metadata=param(description="slide direction in the base frame (unit 3-vector)"),
     )
 
     def model(self) -> SlideModel:

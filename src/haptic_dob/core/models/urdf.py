@@ -33,7 +33,10 @@ class UrdfModel(PinocchioModel):
         coulomb: Coulomb joint friction (N m or N), scalar or per joint; None: each joint's
             ``<dynamics friction>`` from the URDF.
         coulomb_speed: the speed (rad/s or m/s) over which the Coulomb friction turns, scalar or
-            per joint: ``Fc tanh(q' / v_c)``; 0 (the default): ``Fc sgn(q')``.
+            per joint: ``Fc tanh(q' / v_c)``, 0: ``Fc sgn(q')``; None: each joint's
+            ``<haptic_dob:dynamics coulomb_speed>`` from the URDF (0 where it has none).
+        armature: rotor inertia reflected to each joint (kg m^2 or kg), scalar or per joint;
+            None: each joint's ``<haptic_dob:dynamics armature>`` from the URDF (0 where none).
         payload_kg: a point mass (kg) at ``tip_frame``'s origin that the URDF does not have.
 
     Raises ``ValueError`` with a clear message for a bad URDF, an unknown frame or joint, or a
@@ -49,7 +52,8 @@ class UrdfModel(PinocchioModel):
         gravity: bool = True,
         viscous: float | Sequence[float] | None = None,
         coulomb: float | Sequence[float] | None = None,
-        coulomb_speed: float | Sequence[float] = 0.0,
+        coulomb_speed: float | Sequence[float] | None = None,
+        armature: float | Sequence[float] | None = None,
         payload_kg: float = 0.0,
     ) -> None:
         if not str(tip_frame):
@@ -60,6 +64,9 @@ class UrdfModel(PinocchioModel):
         self.tip_frame = str(tip_frame)
         #: per-joint effort limits from the URDF's <limit effort=...> (0 where none)
         self.effort_limits = arm.effort_limits
+        #: per-joint position limits (rad or m; -inf, inf where none) and speed limits (0: none)
+        self.position_limits = arm.position_limits
+        self.velocity_limits = arm.velocity_limits
         super().__init__(
             arm.model,
             arm.frame_id,
@@ -68,7 +75,8 @@ class UrdfModel(PinocchioModel):
             gravity=gravity,
             viscous=arm.damping if viscous is None else viscous,
             coulomb=arm.friction if coulomb is None else coulomb,
-            coulomb_speed=coulomb_speed,
+            coulomb_speed=arm.coulomb_speed if coulomb_speed is None else coulomb_speed,
+            armature=arm.armature if armature is None else armature,
         )
 
     def __repr__(self) -> str:
@@ -87,16 +95,21 @@ class UrdfSettings:
     """
 
     robot_description: str = field(
-        default="", metadata=param("URDF XML of the arm (model: urdf); wins over urdf_path")
+        default="",
+        metadata=param(description="URDF XML of the arm (model: urdf); wins over urdf_path"),
     )
-    urdf_path: str = field(default="", metadata=param("path of the arm's URDF file (model: urdf)"))
+    urdf_path: str = field(
+        default="", metadata=param(description="path of the arm's URDF file (model: urdf)")
+    )
     tip_frame: str = field(
-        default="", metadata=param("URDF frame whose origin is the end-effector point")
+        default="", metadata=param(description="URDF frame whose origin is the end-effector point")
     )
     # a list default: a tuple default would fix the array's length in the parameter table
     joint_names: list[str] | tuple[str, ...] = field(
         default_factory=lambda: [""],
-        metadata=param("joints used, in order; [''] = the chain from the root to tip_frame"),
+        metadata=param(
+            description="joints used, in order; [''] = the chain from the root to tip_frame"
+        ),
     )
 
     def model(self, options: UrdfOptions | None = None) -> UrdfModel:
@@ -115,13 +128,15 @@ class UrdfSettings:
             gravity=opts.gravity,
             viscous=_friction(opts.viscous_n_m_s_per_rad),
             coulomb=_friction(opts.coulomb_n_m),
-            coulomb_speed=_friction(opts.coulomb_speed_rad_per_s) or 0.0,
+            coulomb_speed=_friction(opts.coulomb_speed_rad_per_s),
+            armature=_friction(opts.armature_kg_m2),
             payload_kg=opts.payload_kg,
         )
 
 
 def _friction(values: Sequence[float]) -> float | list[float] | None:
-    """None for [] (the URDF's values), the value for one, the list for one per joint."""
+    """None for [] (the URDF's values), the value for one, the list for one per joint (friction,
+    its turn, armature)."""
     if not values:
         return None
     return float(values[0]) if len(values) == 1 else [float(v) for v in values]
@@ -133,47 +148,65 @@ class UrdfOptions:
 
     gravity: bool = field(
         default=True,
-        metadata=param("include gravity in the model (false: an observer that leaves G out)"),
+        metadata=param(
+            description="include gravity in the model (false: an observer that leaves G out)"
+        ),
     )
     # list defaults: a tuple default would fix the array's length in the parameter table
     viscous_n_m_s_per_rad: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "viscous joint friction (N s/m for a prismatic joint), one value for every joint or "
-            "one per joint; [] = each joint's <dynamics damping> from the URDF",
-            "N m s/rad",
-            0.0,
-            1e3,
+            description=("viscous joint friction, one value or one per joint; [] = the URDF's"),
+            unit="N m s/rad",
+            bounds=(0.0, 1e3),
+            details=(
+                "N s/m for a prismatic joint. [] = each joint's <dynamics damping> from the URDF."
+            ),
         ),
     )
     coulomb_n_m: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "Coulomb joint friction (N for a prismatic joint), one value for every joint or one "
-            "per joint; [] = each joint's <dynamics friction> from the URDF",
-            "N m",
-            0.0,
-            1e3,
+            description=("Coulomb joint friction, one value or one per joint; [] = the URDF's"),
+            unit="N m",
+            bounds=(0.0, 1e3),
+            details=(
+                "N for a prismatic joint. [] = each joint's <dynamics friction> from the URDF."
+            ),
         ),
     )
     coulomb_speed_rad_per_s: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
-            "speed over which the Coulomb friction turns, Fc tanh(q'/v_c) (m/s for a prismatic "
-            "joint), one value for every joint or one per joint; [] or 0 = Fc sgn(q'). An "
-            "observer's model (haptic-identify --urdf fits it); a simulated arm smooths by its "
-            "own physics step and refuses it",
-            "rad/s",
-            0.0,
-            10.0,
+            description="speed over which Coulomb friction turns, Fc tanh(q'/v_c); 0 = Fc sgn(q')",
+            unit="rad/s",
+            bounds=(0.0, 10.0),
+            details=(
+                "m/s for a prismatic joint; one value for every joint or one per joint; [] = each "
+                "joint's <haptic_dob:dynamics coulomb_speed> from the URDF (0 where none). An "
+                "observer's model (haptic-identify --urdf fits it); a simulated arm smooths by its "
+                "own physics step and refuses it."
+            ),
+        ),
+    )
+    armature_kg_m2: list[float] | tuple[float, ...] = field(
+        default_factory=list,
+        metadata=param(
+            description="rotor inertia reflected to each joint (armature)",
+            details=(
+                "Added to the inertia matrix's diagonal (kg for a prismatic joint); one value for "
+                "every joint or one per joint; [] = each joint's <haptic_dob:dynamics armature> "
+                "from the URDF (0 where none)."
+            ),
+            unit="kg m^2",
+            bounds=(0.0, 1e3),
         ),
     )
     payload_kg: float = field(
         default=0.0,
         metadata=param(
-            "a point mass at tip_frame's origin that the URDF does not have (a handle, a tool)",
-            "kg",
-            0.0,
-            100.0,
+            description="a point mass at tip_frame's origin that the URDF lacks (a handle, a tool)",
+            unit="kg",
+            bounds=(0.0, 100.0),
         ),
     )

@@ -1,41 +1,17 @@
 """The nonlinear disturbance observer (thesis ch. 5, after Chen et al. 2000), implicit update.
 
-Continuous observer, ``p(q') = c q'``, ``L = c D(q)^-1``::
+Continuous: ``p(q') = c q'``, ``L = c D(q)^-1``, ``z' = -L z + L (C q' + G + friction - tau - p)``,
+``d_hat = z + p``. Discrete at period T, consistent backward Euler (stable for every c > 0)::
 
-    z'    = -L z + L (C q' + G + friction - tau - p)
-    d_hat = z + p
-
-Discrete update at period T, consistent implicit (backward-Euler) form, stable for every c > 0
-(forward Euler diverges once ``T c / lambda_min(D) > 2``)::
-
-    (D_k + T c I) z_{k+1} = D_k z_k + T c (C q'_k + G_k + friction_k - tau_k - c q'_{k+1})
+    (D_k + T c I) z_{k+1} = D_k z_k + T c (C q'_k + G_k + f_k - tau_k - c q'_{k+1})
     d_hat_{k+1} = z_{k+1} + c q'_{k+1}
 
-Every model but the slide takes the friction's impulse over the period from both its ends:
-``friction_k`` above becomes ``(friction_k + friction_{k+1}) / 2`` (the momentum observer's
-trapezoid). A Coulomb friction that turns within one period (a joint reversing) is otherwise held
-at its value of sample k for the whole period, an error of up to ``2 Fc`` for that period
-(measured on the 7-DOF slave in free motion with its own friction: 0.085 N at the tip with
-friction_k, 0.009 N with the trapezoid). A model's ``_has_friction`` False says its friction, if
-any, is part of its bias effort and taken at sample k. The slide's update keeps the thesis's form.
-
-For the slide the estimate is the disturbance filtered by ``1 / (1 + s m / c)``: time constant
-m/c. This consistent form is the only one whose estimate does not depend on tau and friction; its
-error pole is ``(D + T c_d)^-1 D``. With a constant D (the slide) the update uses the
-pole-matched gain ``c_d = (m / T)(exp(c T / m) - 1)``, so the pole is exactly ``exp(-c T / m)``
-and the time constant exactly m/c at any rate (plain backward Euler, ``c_d = c``, would give
-``T / ln(1 + c T / m)``: 4.9 % long at c T / m = 0.1). With a configuration-dependent D there is
-no single matched gain and ``c_d = c``.
-
-Cycle contract: ``update(q, qd, tau)`` takes the sample at instant k+1 (positions, velocities) and
-the effort applied over [k, k+1); the device's ``joint_states`` of sample k+1 carry exactly that.
-The first call after construction or ``reset()`` only initialises (estimate 0).
-
-Multi-DOF models (the generic path) are costed for the 1 kHz loop: a model that offers
-``_mass_and_bias`` (the pinocchio models) gives D and the bias effort from one pass, the sample is
-validated as one array, and ``wrench`` solves ``J^T F = d_hat`` directly (cofactors for a square J,
-normal equations otherwise) whenever J is provably well-conditioned, the damped least squares on
-an SVD only near a singularity.
+The slide (constant D = m) uses ``c_d = (m / T)(exp(c T / m) - 1)`` for c, so its estimate's
+time constant is exactly m/c, and ``f_k = friction_k``. Other models take
+``f_k = (friction_k + friction_{k+1}) / 2``, unless ``_has_friction`` is False (then the friction
+is in the bias effort, at sample k). ``update(q, qd, tau)`` takes sample k+1 and the effort applied
+over [k, k+1); the first call after construction or ``reset()`` only initialises (estimate 0).
+Why this form, the gain and the friction's mean: docs/design/observer.md.
 """
 
 from __future__ import annotations

@@ -22,29 +22,30 @@ class ObserverSettings:
     gain: float = field(
         default=DEFAULT_GAIN,
         metadata=param(
-            "observer gain: dob c (N s/m prismatic, N m s/rad revolute), momentum K (1/s)",
-            "",
-            1e-6,
-            1e6,
+            description=(
+                "observer gain: dob c (N s/m prismatic, N m s/rad revolute), momentum K (1/s)"
+            ),
+            bounds=(1e-6, 1e6),
         ),
     )
     output_limit: float = field(
         default=0.0,
         metadata=param(
-            "clip of the estimated joint effort; 0 = no clip (the slide sessions use the thesis's "
-            "4 N)",
-            "N or N m",
-            0.0,
-            1e6,
+            description="clip of the estimated joint effort; 0 = no clip",
+            unit="N or N m",
+            bounds=(0.0, 1e6),
+            details="The slide sessions use the thesis's 4 N.",
         ),
     )
     kind: str = field(
         default="dob",
         metadata=param(
-            "the disturbance observer (lag D/c per joint) or the generalized-momentum observer "
-            "(lag 1/gain on every joint)",
+            description=(
+                "observer: dob (lag D/c per joint) or momentum (lag 1/gain on every joint)"
+            ),
             choices=OBSERVER_KINDS,
             read_only=True,
+            details=("dob: the disturbance observer; momentum: the generalized-momentum observer."),
         ),
     )
 

@@ -1,18 +1,16 @@
 """The generalized-momentum observer (De Luca & Mattone 2003), discrete, as an alternative to the
 disturbance observer (``haptic_dob.core.observers.disturbance``).
 
-With ``p = D(q) q'`` the dynamics give ``p' = tau + d - beta``, ``beta = G + friction - C^T q'``
-(``D' = C + C^T``; the model's ``_mass_and_momentum_bias``), so the external effort is
-``d = p' - tau + beta``, with no joint acceleration. The observer filters it through a
-first-order lag of the same time constant ``1/K`` on every joint, whatever the joint's inertia
-(the DOB's lag is ``D / c``: a heavy shoulder slow, a light wrist instant and noisy)::
+With ``p = D(q) q'`` the external effort is ``d = p' - tau + beta``, ``beta = G + friction -
+C^T q'`` (the model's ``_mass_and_momentum_bias``), filtered by the same first-order lag ``1/K``
+on every joint::
 
     r_k = a r_{k-1} + (1 - a) ((p_k - p_{k-1}) / T - tau_k + (beta_k + beta_{k-1}) / 2),
     a = exp(-K T)
 
-``tau_k`` the effort applied over [k-1, k) (the cycle contract), ``beta`` averaged over the
-period (trapezoid). The first update only initialises (estimate 0). Everything else (the output
-clip, the wrench at the tip by ``J^T F = r``) is the disturbance observer's.
+``tau_k`` is the effort applied over [k-1, k) (the cycle contract). The first update only
+initialises (estimate 0). The output clip and the wrench at the tip (``J^T F = r``) are the
+disturbance observer's. Derivation and why one lag: docs/design/observer.md.
 """
 
 from __future__ import annotations

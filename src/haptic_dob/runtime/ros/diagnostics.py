@@ -14,10 +14,16 @@ from typing import Any
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.node import Node
 
+from haptic_dob.runtime.status import Status
 from haptic_msgs_py.topics import DIAGNOSTICS
 
 OK, WARN, ERROR = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR
 Report = tuple[bytes, str, Mapping[str, Any]]
+
+
+def report_of(status: Status) -> Report:
+    """A ROS-free ``Status`` as a report (WARN or OK)."""
+    return (WARN if status.warning else OK), status.message, status.values
 
 
 class Diagnostics:

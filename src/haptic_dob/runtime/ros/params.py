@@ -97,35 +97,39 @@ def typed(spec: ParamSpec, param: Parameter) -> Parameter:
 class ParameterTable:
     """A node's parameters from specs, with whole-snapshot validation and atomic application.
 
+    Construction declares the rows and reads their start-up values (``values``); the node then
+    builds its objects from them and installs its validator with ``set_validator``. Until then a
+    change is checked row by row only.
+
     Args:
         node: the node that owns the parameters.
         specs: the parameter rows.
-        validate: builds the node's settings from a full mapping of proposed values; raises
-            ``ValueError`` (its message is the refusal reason).
-        apply: receives the settings ``validate`` built, after the change is accepted.
+        accepted: called with the changed parameters once a change (after the declaration) is
+            accepted, before rclpy publishes its event (a loop node stamps the event).
     """
 
     def __init__(
         self,
         node: Node,
         specs: Iterable[ParamSpec],
-        validate: Callable[[Mapping[str, Any]], Any] | None = None,
-        apply: Callable[[Any], None] | None = None,
+        accepted: Callable[[list[Parameter]], None] | None = None,
     ) -> None:
         self.node = node
         self.specs = {s.name: s for s in specs}
-        self._validate = validate
-        self._apply = apply
+        self._validate: Callable[[Mapping[str, Any]], Any] | None = None
+        self._apply: Callable[[Any], None] | None = None
+        self._accepted = accepted
         self._pending: Any = None
         self._declaring = True
         self.values: dict[str, Any] = {}
+        self.settings: Any = None
         node.add_pre_set_parameters_callback(self._typed)
         node.add_on_set_parameters_callback(self._on_set)
         node.add_post_set_parameters_callback(self._post_set)
         # values given at start-up (params file, -p) are converted like later sets are; rclpy
         # cannot declare an empty typed array (it re-reads [] as a byte array): such a
         # parameter is declared by its default or type and set empty right after
-        overrides = getattr(node, "_parameter_overrides", {})
+        overrides = node._parameter_overrides
         empty = []
         for name, spec in self.specs.items():
             if name in overrides:
@@ -150,15 +154,16 @@ class ParameterTable:
         for name in self.specs:
             self.values[name] = normalise(self.specs[name], node.get_parameter(name).value)
         self._declaring = False
-        self.settings: Any = validate(self.values) if validate else None
 
     def set_validator(
         self,
         validate: Callable[[Mapping[str, Any]], Any],
         apply: Callable[[Any], None] | None = None,
     ) -> Any:
-        """Install the whole-snapshot validator later (when it needs objects built from the
-        start-up values); validates the current values now and returns the settings."""
+        """Install the whole-snapshot validator, once the node's objects are built from the
+        start-up values: ``validate`` builds the settings from a full mapping of proposed values
+        (``ValueError``: the refusal's reason), ``apply`` receives them once the change is
+        accepted. Validates the current values now and returns the settings."""
         self._validate, self._apply = validate, apply
         self.settings = validate(self.values)
         return self.settings
@@ -179,12 +184,15 @@ class ParameterTable:
             if reason:
                 return SetParametersResult(successful=False, reason=reason)
             proposed[p.name] = normalise(spec, p.value)
-        if self._declaring or self._validate is None:
+        if self._declaring:
             return SetParametersResult(successful=True)
-        try:
-            self._pending = (proposed, self._validate(proposed))
-        except ValueError as exc:
-            return SetParametersResult(successful=False, reason=str(exc))
+        if self._validate is not None:
+            try:
+                self._pending = (proposed, self._validate(proposed))
+            except ValueError as exc:
+                return SetParametersResult(successful=False, reason=str(exc))
+        if self._accepted is not None:
+            self._accepted(params)
         return SetParametersResult(successful=True)
 
     def _post_set(self, params: list[Parameter]) -> None:

@@ -28,11 +28,10 @@ import os
 import signal
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
 import rclpy
-from rcl_interfaces.msg import SetParametersResult
 from rclpy._rclpy_pybind11 import RCLError, UnknownROSArgsError
 from rclpy.context import Context
 from rclpy.exceptions import InvalidParameterValueException, ParameterException
@@ -45,8 +44,10 @@ from rclpy.utilities import try_shutdown
 
 from haptic_dob.runtime.cpu_latency import NO_REQUEST, hold, strictest
 from haptic_dob.runtime.cpus import checked_cpus, pin_process
+from haptic_dob.runtime.params import ParamSpec
 from haptic_dob.runtime.ros.dds_profile import use_default_profile
 from haptic_dob.runtime.ros.log import LoopLog
+from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros_args import shadow_line, shadowed
 from haptic_msgs_py.bus import bus_for
 
@@ -85,25 +86,27 @@ class LoopNode(Node):
     exit_code: int = 0
     finishes_run: bool = False  # it ends its run by itself: the process waits for it to finish
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
+    def __init__(self, node_name: str, *, specs: Iterable[ParamSpec] = (), **kwargs: Any) -> None:
+        """A node named ``node_name`` (``kwargs``: rclpy's ``Node``'s) that declares ``specs``
+        as its parameters (``params``): the subclass reads their start-up values, builds its
+        objects, then installs its validator (``params.set_validator``)."""
+        super().__init__(node_name, **kwargs)
         #: the logger for the loop's callbacks (rclpy's costs 0.3-90 ms a call: ``log``)
         self.log = LoopLog(self.get_logger())
-        # registered before the node's own parameter callbacks, so it runs after them (rclpy
-        # calls the newest first and stops at a refusal): only an accepted change is restamped
-        self.add_on_set_parameters_callback(self._stamp_on_loop_time)
         self.add_post_set_parameters_callback(self._clock_back)
+        self.params = ParameterTable(self, specs, accepted=self._stamp_on_loop_time)
 
     def next_sample_ns(self) -> int | None:
         """Stamp (ns) of the first sample a parameter change made now applies to (None: the
         loop has not run yet)."""
         return None
 
-    def _stamp_on_loop_time(self, params: list[Parameter]) -> SetParametersResult:
+    def _stamp_on_loop_time(self, params: list[Parameter]) -> None:
+        """An accepted change's event gets the loop's stamp (``ParameterTable``'s ``accepted``:
+        called after the node's objects are built, never during the declaration)."""
         stamp = self.next_sample_ns()
         if stamp is not None and not any(p.name == "use_sim_time" for p in params):
             self._clock = _LoopTimeOnce(self, self._clock, stamp)  # type: ignore[assignment]  # a stand-in clock that rclpy's event stamping reads
-        return SetParametersResult(successful=True)
 
     def _clock_back(self, _params: list[Parameter]) -> None:
         if isinstance(self._clock, _LoopTimeOnce):
@@ -125,15 +128,11 @@ class LoopNode(Node):
 
     def cpu_affinity(self) -> list[float]:
         """The CPUs its ``cpu_affinity`` parameter asks for ([] = not pinned)."""
-        params = getattr(self, "params", None)
-        return list(params.values.get("cpu_affinity", [])) if params is not None else []
+        return list(self.params.values.get("cpu_affinity", []))
 
     def cpu_latency_us(self) -> int:
         """The CPU wake-up bound its ``cpu_latency_us`` parameter asks for (-1 = none), us."""
-        params = getattr(self, "params", None)
-        if params is None:
-            return NO_REQUEST
-        return int(params.values.get("cpu_latency_us", NO_REQUEST))
+        return int(self.params.values.get("cpu_latency_us", NO_REQUEST))
 
 
 def pin_to_asked_cpus(nodes: Sequence[Node]) -> None:

@@ -1,0 +1,281 @@
+"""An arm's model from its joint states: rigid body, armature and joint friction beyond CAD.
+
+ROS-free. The URDF gives the kinematics and CAD values, the record joint positions and applied
+efforts (positions differentiated through ``filters``). Effort = ``W theta`` (``arm_parameters``):
+1. the regressor on the first ``1 - holdout`` of the record (filters' ends out, decimated);
+2. each base parameter's visibility: one below ``min_visibility`` is refused, named;
+3. least squares (Coulomb a filtered sign), each joint's ``v_c`` (``arm_friction.turn_speed``),
+   least squares again, then weighted by each joint's residual RMS (``arm_normal``);
+4. a physically consistent full set (``arm_consistent``) drawn toward CAD, checked: mass > 0,
+   centre of mass in the link's box (the origins its link carries and the CAD inertia's
+   equivalent box, plus ``margin_m``), pseudo-inertia positive definite;
+5. each joint's held-out RMS residual against its torque span, identified and CAD.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from haptic_dob.core.models import UrdfModel
+from haptic_dob.core.models._pinocchio_inertia import Body, bodies, body_parameters, moved
+from haptic_dob.identification import arm_parameters as ap
+from haptic_dob.identification.arm_consistent import (
+    ConsistentFit,
+    Link,
+    fit_consistent,
+    inertia_about_com,
+    pseudo_inertia,
+)
+from haptic_dob.identification.arm_friction import coulomb_term, turn_filters, turn_speed
+from haptic_dob.identification.arm_model_report import ArmModelFit, JointFit, LinkFit
+from haptic_dob.identification.arm_normal import Normal, condition_number, solve, square_root
+from haptic_dob.identification.arm_urdf import LinkInertial, link_inertials
+from haptic_dob.identification.filters import IdentificationError, MotionFilters
+
+Arr = NDArray[np.float64]
+#: a base parameter the record determines with more than 1 / this the variance per sample that
+#: motion across the joints' ranges gives is not seen (``arm_parameters.visibility``)
+MIN_VISIBILITY = 1e-4
+#: a link without CAD mass is drawn toward this (kg)
+MASS_FLOOR_KG = 1e-3
+
+
+@dataclass(frozen=True)
+class Record:
+    """Joint states: stamps (ns), positions and efforts over [k-1, k) (N, dof), joint names."""
+
+    stamps_ns: NDArray[np.int64]
+    position: Arr
+    effort: Arr
+    names: tuple[str, ...]
+
+
+def identify_arm_model(
+    urdf: str,
+    tip_frame: str,
+    record: Record,
+    *,
+    cutoff_hz: float = 20.0,
+    holdout: float = 0.3,
+    turn_cutoff_hz: float | None = None,
+    margin_m: float = 0.02,
+    min_visibility: float = MIN_VISIBILITY,
+) -> ArmModelFit:
+    """The arm's model from ``record`` (its joints the URDF's chain to ``tip_frame``, or the
+    joints it names, in its order); ``IdentificationError`` with one line when it cannot."""
+    cad = UrdfModel(urdf, tip_frame, list(record.names))
+    lay = ap.layout_of(cad)
+    n, dof = record.position.shape
+    if record.effort.shape != (n, dof) or dof != cad.dof:
+        raise IdentificationError(f"the record has {dof} joints, the model {cad.dof}")
+    if n < 500:
+        raise IdentificationError(f"too short: {n} samples, need 500")
+    dt = float(np.median(np.diff(record.stamps_ns))) * 1e-9
+    if not (
+        dt > 0.0 and np.all(np.isfinite(record.position)) and np.all(np.isfinite(record.effort))
+    ):
+        raise IdentificationError("the stamps do not increase, or a value is not finite")
+    f = MotionFilters.design(dt, cutoff_hz)
+    wide = f if turn_cutoff_hz is None else turn_filters(dt, cutoff_hz, turn_cutoff_hz)
+    position = np.unwrap(record.position, axis=0)
+    x, v, a = f.motion(position)
+    tau = f.effort(record.effort)
+    v_light = f.light_velocity(position)
+    split = int((1.0 - holdout) * n)
+    idx = np.arange(2 * f.window, split, f.step)
+    held = np.arange(split, n - 2 * f.window, f.step)
+    if len(held) < 10 or len(idx) * dof < 3 * lay.size:
+        raise IdentificationError(f"too short: {len(idx)} samples to fit, {len(held)} held out")
+    sign = f.coulomb_term(v_light)
+    W = ap.regressor(cad, x[idx], v[idx], a[idx], sign[idx])
+    y = tau[idx].ravel()
+    W_ref = ap.regressor(cad, *ap.reference_states(cad, ap.REFERENCE_STATES))
+    bs = ap.base_set(W_ref)
+    names = bs.names(lay)
+    normal = Normal.of(W, y, dof)
+    G, b, yy = normal.total()
+    G_ref = W_ref.T @ W_ref / ap.REFERENCE_STATES
+    seen = ap.visibility(G[np.ix_(bs.base, bs.base)] / len(idx), G_ref[np.ix_(bs.base, bs.base)])
+    unseen = ap.unseen_names(names, seen, min_visibility)
+    if unseen:
+        more = f" and {len(unseen) - 8} more" if len(unseen) > 8 else ""
+        raise IdentificationError(
+            f"too little excitation: the record does not see {', '.join(unseen[:8])}{more} (its "
+            f"motion determines each less than {min_visibility:g} as well as motion across the "
+            "joints' ranges would); record a richer excitation (haptic-excite)"
+        )
+    beta, _, _ = solve(G, b, yy, len(y), bs.base, "the arm")
+    speeds = _turn_speeds(
+        cad, (f, wide), (position, record.effort, v_light), (W, y, idx, split), bs, beta, lay
+    )
+    coulomb = np.column_stack([coulomb_term(f, v_light[:, j], c) for j, c in enumerate(speeds)])
+    W = ap.with_coulomb(W, coulomb[idx])
+    normal = Normal.of(W, y, dof)
+    beta, _, _ = solve(*normal.total(), len(y), bs.base, "the arm")
+    weight = 1.0 / np.maximum(normal.residual_rms(bs.base, beta), 1e-12)  # each joint's rows
+    Gw, bw, yyw = normal.total(weight)
+    beta, std, sigma = solve(Gw, bw, yyw, len(y), bs.base, "the arm")
+    inertials = link_inertials(urdf)
+    links = [_link(b, inertials, margin_m) for b in bodies(cad)]
+    cad_joint = np.concatenate([cad.armature, cad.viscous, cad.coulomb])
+    scale = _joint_scales(cad, x[idx], (beta, std), bs, lay)
+    start = cad_joint.copy()
+    at = bs.base >= lay.rigid
+    start[bs.base[at] - lay.rigid] = beta[at]  # least squares' friction and armature
+    R, z = square_root(Gw, bw)
+    found = fit_consistent(R, z, sigma, links, (cad_joint, scale, start))
+    _check(lay.links, links, found)
+    W_held = ap.regressor(cad, x[held], v[held], a[held], coulomb[held])
+    cad_theta = np.concatenate([body_parameters(cad).ravel(), cad_joint])
+    pred = (W_held @ found.theta).reshape(len(held), dof)
+    pred_cad = (ap.with_coulomb(W_held, sign[held]) @ cad_theta).reshape(len(held), dof)
+    heldout = (tau[held] - pred, tau[held] - pred_cad, np.ptp(tau[held], axis=0))
+    return ArmModelFit(
+        links=tuple(
+            _link_fit(n, k, c) for n, k, c in zip(lay.links, links, found.links, strict=True)
+        ),
+        joints=_joint_fits(lay.joints, found, speeds, heldout),
+        holdout=holdout,
+        samples=len(idx),
+        condition_number=condition_number(normal.total()[0], bs.base),
+        visibility=tuple((nm, float(v_)) for nm, v_ in zip(names, seen, strict=True)),
+        unidentifiable=tuple(lay.names[i] for i in bs.dependent),
+    )
+
+
+def _turn_speeds(
+    cad: UrdfModel,
+    filters: tuple[MotionFilters, MotionFilters],
+    raw: tuple[Arr, Arr, Arr],
+    fitted: tuple[Arr, Arr, NDArray[np.intp], int],
+    bs: ap.BaseSet,
+    beta: Arr,
+    lay: ap.Layout,
+) -> list[float]:
+    """Each joint's ``v_c`` (``arm_friction.turn_speed``) on the effort the fitted rigid body and
+    armature leave; ``raw``: positions, efforts, light velocity; ``fitted``: W, y, samples and
+    the held-out part's start."""
+    f, wide = filters
+    position, effort, v_light = raw
+    W, y, idx, split = fitted
+    n, dof = position.shape
+    rigid = np.zeros(lay.size)  # the fitted rigid body and armature, no friction
+    keep = bs.base < lay.rigid + dof
+    rigid[bs.base[keep]] = beta[keep]
+    _, v, _ = f.motion(position)
+    r = np.zeros((n, dof))
+    r[idx] = (y - W @ rigid).reshape(len(idx), dof)
+    if wide is f:
+        v_w, r_w, idx_w = v, r, idx
+    else:
+        x_w, v_w, a_w = wide.motion(position)
+        idx_w = np.arange(2 * wide.window, split, wide.step)
+        W_w = ap.regressor(cad, x_w[idx_w], v_w[idx_w], a_w[idx_w], np.zeros((len(idx_w), dof)))
+        r_w = np.zeros((n, dof))
+        r_w[idx_w] = wide.effort(effort)[idx_w] - (W_w @ rigid).reshape(-1, dof)
+    return [
+        turn_speed(
+            f, wide, v_light[:, j], (v[:, j], r[:, j], idx), (v_w[:, j], r_w[:, j], idx_w), name
+        )
+        for j, name in enumerate(lay.joints)
+    ]
+
+
+def _link(body: Body, inertials: dict[str, LinkInertial], margin_m: float) -> Link:
+    """The child link's CAD values, its box (see the module) and the other links' parameters."""
+    name, pose = body.links[0]
+    if not np.allclose(pose, np.eye(4)):
+        raise IdentificationError(f"link {name}: its frame is not its joint's")
+    cad = inertials[name]
+    rest = np.zeros(10)
+    for other, other_pose in body.links[1:]:
+        li = inertials[other]
+        rest += moved(other_pose, li.mass, li.com, li.inertia)
+    mass = cad.mass if cad.mass > 0.0 else MASS_FLOOR_KG
+    sigma = 0.5 * np.trace(cad.inertia) * np.eye(3) - cad.inertia
+    reach = np.sqrt(3.0 * np.maximum(np.diag(sigma), 0.0) / mass) if cad.mass > 0.0 else np.zeros(3)
+    points = np.vstack([body.points, cad.com, cad.com - reach, cad.com + reach])
+    lo, hi = points.min(axis=0) - margin_m, points.max(axis=0) + margin_m
+    floor = 1e-4 * mass * float(np.mean((0.5 * (hi - lo)) ** 2))
+    low = float(np.linalg.eigvalsh(sigma)[0])
+    if low < floor:  # a CAD inertia that is no body's (a point mass, a placeholder)
+        sigma = sigma + (floor - low) * np.eye(3)
+    return Link(mass, cad.com.copy(), sigma, lo, hi, rest)
+
+
+def _joint_scales(
+    cad: UrdfModel, x: Arr, estimate: tuple[Arr, Arr], bs: ap.BaseSet, lay: ap.Layout
+) -> Arr:
+    """What a change of each joint parameter is counted in: its estimate plus three standard
+    errors where it is a base parameter, else (an armature carried by a body) the CAD inertia
+    the joint moves."""
+    beta, std = estimate
+    dof = len(lay.joints)
+    inertia = np.mean([np.diag(cad.mass_matrix(q)) for q in x[:: max(1, len(x) // 20)]], axis=0)
+    out = np.concatenate([inertia, np.ones(2 * dof)])
+    for k, column in enumerate(bs.base):
+        if column >= lay.rigid:
+            out[column - lay.rigid] = abs(beta[k]) + 3.0 * std[k]
+    scale: Arr = np.maximum(out, 1e-9)
+    return scale
+
+
+def _check(names: Sequence[str], links: Sequence[Link], found: ConsistentFit) -> None:
+    """Physical consistency of every link (see the module); ``IdentificationError`` naming one
+    that is not (the parametrisation should make that impossible)."""
+    for name, link, (m, c, sigma) in zip(names, links, found.links, strict=True):
+        low = float(np.linalg.eigvalsh(pseudo_inertia(m, c, sigma))[0])
+        if not (m > 0.0 and low > 0.0 and np.all(c >= link.lo) and np.all(c <= link.hi)):
+            raise IdentificationError(
+                f"{name}: the fit is not physically consistent (mass {m:.4g} kg, centre of "
+                f"mass {np.round(c, 4).tolist()} m, pseudo-inertia eigenvalue {low:.3g})"
+            )
+
+
+def _link_fit(name: str, link: Link, found: tuple[float, Arr, Arr]) -> LinkFit:
+    m, c, sigma = found
+    inertia = inertia_about_com(sigma)
+    xx, xy, xz = (float(v) for v in inertia[0])
+    yy, yz, zz = float(inertia[1, 1]), float(inertia[1, 2]), float(inertia[2, 2])
+    return LinkFit(
+        link=name,
+        mass=float(m),
+        com=_triple(c),
+        inertia=(xx, xy, xz, yy, yz, zz),
+        cad_mass=link.mass,
+        cad_com=_triple(link.com),
+        box_lo=_triple(link.lo),
+        box_hi=_triple(link.hi),
+        pseudo_inertia_min=float(np.linalg.eigvalsh(pseudo_inertia(m, c, sigma))[0]),
+    )
+
+
+def _triple(v: Arr) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def _joint_fits(
+    joints: Sequence[str],
+    found: ConsistentFit,
+    speeds: Sequence[float],
+    heldout: tuple[Arr, Arr, Arr],
+) -> tuple[JointFit, ...]:
+    e, e_cad, span = heldout
+    rms, rms_cad = np.sqrt(np.mean(e * e, axis=0)), np.sqrt(np.mean(e_cad * e_cad, axis=0))
+    return tuple(
+        JointFit(
+            joint=name,
+            armature=float(found.armature[j]),
+            viscous=float(found.viscous[j]),
+            coulomb=float(found.coulomb[j]),
+            coulomb_speed=float(speeds[j]),
+            heldout_rms=float(rms[j]),
+            heldout_rms_cad=float(rms_cad[j]),
+            torque_span=float(span[j]),
+        )
+        for j, name in enumerate(joints)
+    )
