@@ -1,26 +1,18 @@
 """Whether this machine can carry a loop in real time, measured by the suite itself (once per
 layout): the CPU a cycle costs, against the CPU a period gives, and the DDS floor of its path.
 
-A test whose premise is real time at 1 kHz (the device ticking on the wall clock, commands due
-before the next tick) holds on a machine where the loop's work of a cycle fits in a period. The
-measurement is a short lockstep run of the same layout (the same processes, nodes and topics the
-test watches): the CPU time (user + system, from ``/proc``) its processes spend from sample 0 to
-the last, over its cycles, which is what a cycle costs in real time too, however long lockstep's
-own hand-overs make a cycle last. It holds when
+The measurement is a short lockstep run of the test's layout (the same processes, nodes and
+topics): the CPU time (user + system, ``/proc``) its processes spend per cycle, which is what a
+cycle costs in real time too. It holds when
 
-- the cycle's CPU across the loop's processes (and this test's watchers) fits in ``CPU_SHARE``
-  of the CPUs the run may use times the period: the CPUs of its affinity, less what other
-  processes kept busy on them meanwhile (``/proc/stat``; on a machine others load, a loop that
-  would fit an idle one misses its ticks), and
-- the busiest process's fits in ``CPU_SHARE`` of one period (a process works its cycle through
-  in one spin thread), and
-- across processes, the raw DDS hops on the command's path (``haptic_dob.runtime.ros.dds_hop``)
-  fit in ``HOPS_SHARE`` of a period: no node goes under that floor.
+- the cycle's CPU across the loop's processes and the test's watchers fits in ``CPU_SHARE`` of
+  the free CPUs of the run's affinity (less what other processes kept busy, ``/proc/stat``)
+  times the period;
+- the busiest process's fits in ``CPU_SHARE`` of one period (one spin thread each);
+- the raw DDS hops on the command's path (``haptic_dob.runtime.ros.dds_hop``) fit in
+  ``HOPS_SHARE`` of a period.
 
-Otherwise the test skips, saying the figures. (It replaced the lockstep real-time factor, which
-counts every hand-over's wake-up as work: it skipped 7 of 8 real-time tests on a machine where a
-composed real-time session kept every command on time.)
-"""
+Otherwise the test skips, saying the figures."""
 
 from __future__ import annotations
 

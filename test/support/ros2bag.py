@@ -1,23 +1,17 @@
 """Bags as rosbag2 Jazzy's ``ros2 bag record`` writes them, for tests (no rosbag2 runs here).
 
-Taken from rosbag2's sources (ros2/rosbag2, branch jazzy):
+From rosbag2's sources (ros2/rosbag2, branch jazzy):
 
-- MCAP (``rosbag2_storage_mcap/src/mcap_storage.cpp``): libmcap with the ``ros2`` profile, 768 KiB
-  chunks without chunk CRCs, uncompressed (storage preset ``none``, the default) or zstd
-  (``--storage-preset-profile zstd_fast``); a schema per type, encoding ``ros2msg``, holding the
-  full text ``rosbag2_cpp``'s ``LocalMessageDefinitionSource`` builds from the installed ``.msg``
-  files; a channel per topic (``cdr``) with the metadata ``offered_qos_profiles`` and
-  ``topic_type_hash``; each message with log time = receive time, publish time = send time,
-  sequence 0; the bag's metadata as the ``rosbag2`` metadata record, written at close. Written
-  here with Foxglove's ``mcap`` writer (the summary CRC is left 0, which libmcap computes).
-- sqlite3 (``rosbag2_storage_sqlite3/src/.../sqlite_storage.cpp``): its ``CREATE`` statements of
-  schema version 4 as they are, a ``message_definitions`` row per type, the messages inserted as
-  they came, the metadata row inserted at close.
-- ``metadata.yaml`` (``rosbag2_storage``'s ``metadata_io.cpp`` and ``yaml.hpp``, ``qos.cpp``):
-  version 9, every QoS profile a map with the policies' names, the type description hashes
-  (RIHS01) of the installed types, ``custom_data: ~``, ``ros_distro: jazzy``; the storage file
-  ``<bag>_0.mcap`` or ``<bag>_0.db3``.
-"""
+- MCAP (``mcap_storage.cpp``): the ``ros2`` profile, 768 KiB chunks without CRCs, uncompressed
+  or zstd (``zstd_fast``); a schema per type (``ros2msg``, the full text rosbag2 builds from the
+  ``.msg`` files); a channel per topic (``cdr``) with ``offered_qos_profiles`` and
+  ``topic_type_hash``; log time = receive time, publish time = send time; the ``rosbag2``
+  metadata record at close. Written with Foxglove's ``mcap`` writer.
+- sqlite3 (``sqlite_storage.cpp``): schema version 4's ``CREATE`` statements, a
+  ``message_definitions`` row per type, the metadata row at close.
+- ``metadata.yaml`` (``metadata_io.cpp``, ``qos.cpp``): version 9, QoS profiles as maps, the
+  types' RIHS01 hashes, ``custom_data: ~``, ``ros_distro: jazzy``; storage ``<bag>_0.mcap`` or
+  ``<bag>_0.db3``."""
 
 from __future__ import annotations
 

@@ -1,25 +1,16 @@
 """The teleoperation graph in real time at 1 kHz, all in one process (``haptic-launch teleop_sim
---set '**/device_node:clock_mode=realtime'``): the loop closes over the channel, and
-when the link dies (``channel.cut_at_s``) the master renders exactly zero force within the
-watchdog and the slave holds where it is. Bounds in samples.
+--set '**/device_node:clock_mode=realtime'``): the loop closes over the channel, and when the
+link dies (``channel.cut_at_s``) the master renders exactly zero force within the watchdog and
+the slave holds where it is. Bounds in samples.
 
-In real time each device ticks on its own clock and stamps its samples with the system clock, so a
-side's sample index is the whole periods since its first sample (as each channel end counts them,
-``SampleClock``), and the two sides' samples are apart by their start-up skew (each device starts
-once its own side is up and the other's device is built, ``start_with``, plus what each still waits
-for): the slave's last message before the cut reaches the master at the master's sample ``C - 1 +
-max(delay, lag)``, where ``lag`` is how many samples the slave is behind the master when it sends
-that message (measured here from when the test's readers got both sides' link messages). The
-master's end then goes silent ``timeout`` samples later (20 ms, 21 samples), as the batch run's
-does; the slave's end likewise with the master's lag. The upper bound allows ``SLACK`` samples for
-the hand-over and the lag's measurement.
-
-Skips where the suite's capacity measurement says this machine cannot give a cycle of the graph
-the CPU it costs at 1 kHz now (``capacity.require_realtime_teleop``). A process per side
-(``--group master --group slave``) is not tested here: a stall of one process over the 20 ms
-watchdog makes the other end find its peer silent and then back, before any cut (seen once on
-this machine when the old lockstep probe measured over 1.2x real time).
-"""
+Each device ticks on its own clock, so a side's sample index is its whole periods since its
+first sample (``SampleClock``), and the sides are apart by their start-up skew. The slave's last
+message before the cut reaches the master at its sample ``C - 1 + max(delay, lag)`` (``lag``:
+how far the slave is behind, measured from the test's readers); the master's end goes silent
+``timeout`` samples later (21), as in batch. ``SLACK`` samples allow for the hand-over and the
+lag's measurement. Skips where ``capacity.require_realtime_teleop`` says the machine cannot
+carry the graph now. A process per side is not tested: a stall over the 20 ms watchdog makes
+each end find its peer silent before any cut."""
 
 from __future__ import annotations
 

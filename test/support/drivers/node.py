@@ -1,28 +1,18 @@
 """A test driver: a real driver's topics over a simulated plant, on the wall clock, truth kept.
 
 ``python test/support/drivers/node.py CONFIG.json`` runs one driver until SIGINT/SIGTERM, then
-writes ``truth.json`` (the plant's hidden parameters, what the driver counted, its last command)
-and ``series.npz`` (per cycle: stamp, positions, the effort applied, the true hand force, the tip;
-per command: arrival, the state answered, values) into the config's ``out`` directory.
+writes ``truth.json`` (the plant's hidden parameters, counts, its last command) and
+``series.npz`` (per cycle and per command) into the config's ``out`` directory. Config keys:
+``kind`` (``fd``, ``touch``, ``arm``), ``rate_hz``, ``seed``, ``out``, ``hand``,
+``hand_direction``, ``button`` and ``inkwell`` (touch), ``table_z`` (arm); test controls in the
+driver's namespace: ``test/pause`` (``Float64``: no state for that many seconds) and
+``test/button`` (``Bool``).
 
-Config keys: ``kind`` (``fd``, ``touch``, ``arm``), ``rate_hz``, ``seed``, ``out``, ``hand``
-(``HandParams`` fields), ``hand_direction`` (fd, touch: the push's unit vector in the base
-frame), ``button`` (touch: the white button held from the start), ``inkwell`` (touch: the
-stylus rests in its inkwell, the plant held at its start, until the first force the driver
-applies: an arm nobody holds falls under its weight while the loop starts), ``table_z`` (arm). Test
-controls in the driver's namespace: ``test/pause`` (``std_msgs/Float64``: publish no state for
-that many seconds, the plant and the commands going on) and ``test/button``
-(``std_msgs/Bool``, touch: the white button).
-
-The cycle is the driver's: at tick k+1 the plant moves over [k, k+1) with the effort in force
-(ros2_control: the command written at tick k; Touch: the newest force, on arrival), then state
-k+1 goes out stamped with its instant on the system clock: the first tick's time plus k+1
-periods. The plant moves exactly one period a tick, so that stamp is the instant its positions
-are true, as a real driver's stamp is the instant it read its device (the tick's own wall time
-would carry the Python driver's jitter into every difference of positions over stamps, which a
-real device does not have). Command k is on time when it answers state k and arrives before
-tick k+1.
-"""
+At tick k+1 the plant moves over [k, k+1) with the effort in force (ros2_control: the command
+written at tick k; Touch: the newest force), then state k+1 goes out stamped with the first
+tick's time plus k+1 periods: the instant its positions are true, as a real driver's stamp is
+(not the Python tick's jittery wall time). Command k is on time when it answers state k and
+arrives before tick k+1."""
 
 from __future__ import annotations
 

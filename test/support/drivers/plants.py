@@ -1,22 +1,16 @@
 """The simulated plants under the test drivers, with the truth a test knows and the loop does not.
 
-A plant is anything with the simulated device's cycle contract (``haptic_sim.device.sample.
-SimulatedDevice``: ``sample()`` is sample k, ``apply(effort)`` holds an effort over [k, k+1) and
-steps to k+1) plus ``truth()``, its hidden parameters. A driver owns one and never looks inside.
+A plant has the simulated device's cycle contract (``haptic_sim.device.sample.SimulatedDevice``:
+``sample()`` is sample k, ``apply(effort)`` holds an effort over [k, k+1)) plus ``truth()``.
 
-- ``point_mass``: ``config/point_mass_sim.yaml``'s simulated Cartesian device
-  (``haptic_sim.point_mass``: its truth ``cartesian.*``, stiction, amplifier lag, encoder counts
-  after noise), as a Force Dimension under forcedimension_ros2: joints ``fd_x, fd_y, fd_z`` in
-  metres, effort the force applied.
-- ``touch``: ``config/phantom_omni_sim.yaml``'s simulated Touch (the simulated arm on
-  ``config/urdf/phantom_omni.urdf`` with a payload, joint friction and encoder counts the URDF
-  lacks): joints ``waist, shoulder, elbow`` as the community Touch drivers publish them.
+- ``point_mass``: ``config/point_mass_sim.yaml``'s Cartesian device (stiction, amplifier lag,
+  encoder counts) as a Force Dimension: joints ``fd_x, fd_y, fd_z`` in metres.
+- ``touch``: ``config/phantom_omni_sim.yaml``'s simulated Touch (a payload, joint friction and
+  encoder counts ``phantom_omni.urdf`` lacks): joints ``waist, shoulder, elbow``.
 - ``arm7``: ``config/urdf/arm7.urdf`` with gearbox friction and a table below the tool, as a
   Franka-like ros2_control arm.
 
-A test changes the simulated devices' truth only through those configs (and the hand, the seed,
-the rate and the physics' sub-steps a driver ticks at).
-"""
+A test changes a plant's truth only through those configs (and the hand, seed, rate, sub-steps)."""
 
 from __future__ import annotations
 

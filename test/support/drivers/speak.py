@@ -1,23 +1,16 @@
 """What each test driver speaks on the wire, as the real drivers do (read from their sources).
 
-- ``Ros2Control``: a ``ros2_control`` system with ``joint_state_broadcaster`` and an effort
-  ``forward_command_controller`` (ICube's forcedimension_ros2, a Franka or UR arm):
-  ``<ns>/joint_states`` (position, velocity, effort; ``SystemDefaultsQoS``: reliable) and
-  ``<ns>/<controller>/commands`` (``Float64MultiArray`` in the controller's ``joints`` order). A
-  message with a non-finite value is dropped; one of the wrong size is held and makes every
-  update fail, the joints keeping the last values written; the newest command is written at the
-  next update (a command arriving during cycle k acts from cycle k+1) and held forever (no
-  timeout: ros2_controllers #95).
-- ``Touch``: a community Geomagic Touch driver (AleBarte/Geomagic_Touch_ROS2_Drivers), here at
-  500 Hz with ``SensorDataQoS`` as the Touch X driver publishes: ``<ns>/joint_states`` with
-  positions only (waist, shoulder, elbow and the gimbal, named and signed as ``omni_state.cpp``
-  publishes them: config/urdf/phantom_omni.urdf's joints), the stylus buttons as ``sensor_msgs/
-  Joy`` on change (grey, white), and ``<ns>/force_feedback`` (``WrenchStamped``, reliable)
-  applied only while the white button is held, on arrival (the device's servo loop), clamped to
-  the device's maximum force. The force is in the driver's pose frame: ``omni_state_main.cpp``
-  maps the force to the device's axes with the inverse of the map it gives the position
-  (docs/devices.md has the lines), so it is phantom_omni.urdf's base frame, no axis map.
-"""
+- ``Ros2Control`` (forcedimension_ros2, a Franka or UR arm): ``<ns>/joint_states`` (position,
+  velocity, effort; reliable) and ``<ns>/<controller>/commands`` (``Float64MultiArray`` in the
+  controller's ``joints`` order). A non-finite command is dropped; one of the wrong size is held
+  and fails every update; the newest command is written at the next update (cycle k+1) and held
+  forever (ros2_controllers #95).
+- ``Touch`` (AleBarte/Geomagic_Touch_ROS2_Drivers) at 500 Hz, ``SensorDataQoS``:
+  ``<ns>/joint_states`` with positions only (phantom_omni.urdf's joints, named and signed as
+  ``omni_state.cpp`` publishes them), the buttons as ``sensor_msgs/Joy`` on change (grey,
+  white), and ``<ns>/force_feedback`` (``WrenchStamped``, reliable) applied on arrival only while
+  the white button is held, clamped to the device's maximum, in the pose frame (the URDF's base
+  frame, no axis map; docs/devices.md has the driver's lines)."""
 
 from __future__ import annotations
 
