@@ -10,10 +10,9 @@ An exception out of any node's callback ends the process, but first every node's
 
 Nothing published is lost at a clean stop: a process whose nodes all report a ``drain_marker``
 (the observer) first works off the inputs still coming, until the marker stops changing for
-``DRAIN_QUIET_S``, for at most ``WORK_OFF_S`` (off the lockstep critical path, the observer may be
-a few samples behind when the device finishes; in real time new samples keep coming). Then every
-process waits until its reliable readers acknowledged what it published (a recorder or a slow
-reader may still be repairing a lost sample), all within ``DRAIN_BUDGET_S``. A device node has no
+``DRAIN_QUIET_S``, for at most a full input queue of samples (``WORK_OFF_SAMPLES``: in real time
+new samples keep coming; a slow machine takes longer, not fewer). Then every process waits until
+its reliable readers acknowledged what it published, within ``DRAIN_BUDGET_S``. A device node has no
 marker: it zeroes its effort at once.
 
 A process stops when a node finishes (a device at the end of its ``duration_s``), once every node
@@ -50,11 +49,14 @@ from haptic_dob.runtime.ros.log import LoopLog
 from haptic_dob.runtime.ros.params import ParameterTable
 from haptic_dob.runtime.ros_args import shadow_line, shadowed
 from haptic_msgs_py.bus import bus_for
+from haptic_msgs_py.ros.qos import LOOP_IN_DEPTH
 
 EXECUTORS = ("events", "single")
-DRAIN_BUDGET_S = 2.0  # at most this long for the work-off and the acknowledgements at a stop
+DRAIN_BUDGET_S = 2.0  # at most this long for the acknowledgements at a stop
 DRAIN_QUIET_S = 0.2  # inputs are worked off when the marker did not change for this long
-WORK_OFF_S = 0.5  # ... or after this long
+QUIET_SPINS = 5  # ... and over this many spins
+WORK_OFF_SAMPLES = LOOP_IN_DEPTH  # ... or after this many changes: what a queue held at the stop
+WORK_OFF_S = 10.0  # ... or, a backstop, after this long
 LAST_WORDS_S = 0.5  # after an error: how long the zero's acknowledgement may take
 #: while nodes of this process hand the loop around in process (lockstep), the executor (DDS
 #: from other processes, services, timers) gets a turn at least this often (s)
@@ -293,12 +295,11 @@ def run_nodes(
         if profile_dir:
             prof.disable()
             prof.dump_stats(os.path.join(profile_dir, f"{nodes[0].get_name()}.prof"))
-        drain_until = monotonic() + DRAIN_BUDGET_S
         if loop_nodes and all(n.drain_marker() is not None for n in loop_nodes):
             work_off(spin_once, loop_nodes, monotonic() + WORK_OFF_S)
         for n in loop_nodes:
             n.on_shutdown()
-        wait_for_acknowledgements(nodes, drain_until)
+        wait_for_acknowledgements(nodes, monotonic() + DRAIN_BUDGET_S)
         ex.shutdown(timeout_sec=1.0)
         codes = [n.exit_code for n in loop_nodes if n.finished and n.exit_code]
         return codes[0] if codes else 0
@@ -324,16 +325,28 @@ def last_words(nodes: Sequence[LoopNode]) -> None:
     wait_for_acknowledgements(nodes, time.monotonic() + LAST_WORDS_S)
 
 
-def work_off(spin_once: Callable[..., None], nodes: Sequence[LoopNode], until: float) -> None:
-    """Spin until no node's ``drain_marker`` changed for ``DRAIN_QUIET_S`` (or ``until``)."""
+def work_off(
+    spin_once: Callable[..., None],
+    nodes: Sequence[LoopNode],
+    until: float,
+    samples: int = WORK_OFF_SAMPLES,
+) -> int:
+    """Spin until no node's ``drain_marker`` changed for ``DRAIN_QUIET_S`` and ``QUIET_SPINS``
+    spins (a starved process's spins, not the wall clock, say its inputs stopped), or the
+    markers changed ``samples`` times, or ``until`` (monotonic s); the number of changes."""
     last = [n.drain_marker() for n in nodes]
-    quiet_since = time.monotonic()
-    while (now := time.monotonic()) < until and now - quiet_since < DRAIN_QUIET_S:
-        spin_once(timeout_sec=DRAIN_QUIET_S / 5)
+    quiet_since, quiet_spins, changes = time.monotonic(), 0, 0
+    while time.monotonic() < until and changes < samples:
+        if quiet_spins >= QUIET_SPINS and time.monotonic() - quiet_since >= DRAIN_QUIET_S:
+            break
+        spin_once(timeout_sec=DRAIN_QUIET_S / QUIET_SPINS)
         markers = [n.drain_marker() for n in nodes]
         if markers != last:
-            last = markers
-            quiet_since = time.monotonic()
+            last, quiet_since, quiet_spins = markers, time.monotonic(), 0
+            changes += 1
+        else:
+            quiet_spins += 1
+    return changes
 
 
 def wait_for_acknowledgements(nodes: Sequence[Node], until: float) -> bool:
