@@ -5,16 +5,13 @@
     .venv/bin/python scripts/bench_analysis.py --only 40s --storage sqlite3 --runs 7
 
 The bags are written with the rosbags writer (``haptic_dob.bag.write``) into ``--dir`` (kept for
-the next run) and look like a recording of the node graph: every session topic at 1 kHz plus
-``/parameter_events`` (nine messages per sample):
+the next run) like a recording of the node graph: every session topic at 1 kHz plus
+``/parameter_events`` (nine messages per sample). ``40s``: the default 40 s slide session (DOB,
+Kf = 1, 800 N/m) from the batch runner; ``1h``: its motion and force repeated 90 times.
 
-- ``40s``: the default 40 s slide session (DOB, Kf = 1, 800 N/m) from the batch runner;
-- ``1h``: one hour at 1 kHz: the 40 s session's motion and force repeated 90 times.
-
-Each run starts ``haptic-analyze BAG`` as a child process and measures the wall time from just
-before the process starts to its exit (the output is complete then), and the child's peak
-resident memory (``os.wait4`` rusage ``ru_maxrss``). Medians of ``--runs`` runs are printed. The
-bag files are in the page cache (just written or read by the previous run).
+Each run times ``haptic-analyze BAG`` as a child process from just before it starts to its exit,
+and reads its peak resident memory (``os.wait4`` ``ru_maxrss``); medians of ``--runs`` runs are
+printed. The bag files are in the page cache (just written or read by the previous run).
 """
 
 from __future__ import annotations

@@ -4,17 +4,14 @@ Each pattern is a few rclpy processes (events executor, raw bytes of a small mes
 QoS) that pass messages and do nothing else; its cycle is what DDS and rclpy cost for that
 pattern with no maths and no node logic. ``loop`` is the messages a slide DOB cycle passes
 between ``--processes`` nodes: the device sends pose, twist, joint states and the sensor's
-wrench; the environment answers pose + twist with one message, the observer answers the joint
-states with one; the controller answers wall + estimate with the command, which releases the
-device's next sample, and takes the sensor's wrench as well (it uses it in CL). The 4-process
-lockstep cycle compared with (``loop`` + the batch cycle) is what the nodes add. The others say
-where the loop's own floor lies against the raw hop (``bench_hop``): ``one-message`` is the same
-four processes with the device sending one message that both the environment and the observer
-take; ``ring`` is three processes passing one message around (device -> environment ->
-controller -> device: the three hops of the margin's floor, in three processes); ``ping-pong``
-is two (device -> controller -> device), which should come out at two hops. Used by
-``benchmarks.py pattern`` and ``margin``; each process is set up as the hop's
-(``haptic_dob.runtime.ros.dds_hop.peer_node``).
+wrench; the environment answers pose + twist, the observer the joint states, one message each;
+the controller answers wall + estimate with the command, which releases the device's next
+sample (it takes the sensor's wrench too, as in CL). The 4-process lockstep cycle against
+(``loop`` + the batch cycle) is what the nodes add. Against the raw hop (``bench_hop``):
+``one-message`` is ``loop`` with one device message for both environment and observer; ``ring``
+passes one message through three processes (device -> environment -> controller -> device);
+``ping-pong`` through two, which should come out at two hops. Used by ``benchmarks.py pattern``
+and ``margin``; each process is set up as the hop's (``haptic_dob.runtime.ros.dds_hop.peer_node``).
 """
 
 from __future__ import annotations

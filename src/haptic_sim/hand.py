@@ -1,28 +1,17 @@
 """The simulated human hand: a mass-spring-damper grip coupled to a reference motion.
 
-The hand holds the handle: its mass ``m_h`` moves with the device, and a spring ``k_h`` and damper
-``b_h`` pull it toward a reference position ``x_r(t)`` that the "person" moves. The force on the
-device (what a handle force sensor reads) is ``F_h = k_h (x_r - x) + b_h (x_r' - x') + f_ff(t)
-- m_h x''``; ``f_ff`` is an additional feed-forward force (the perturbation of the vibration
-protocol). All quantities act along the device's axis (1-D) and are SI.
-
-Behaviours (``HandParams.behaviour``):
+The hand's mass ``m_h`` moves with the device, held by a spring ``k_h`` and damper ``b_h`` to a
+reference ``x_r(t)``; the force on the device (a handle sensor's reading, 1-D along its axis, SI)
+is ``F_h = k_h (x_r - x) + b_h (x_r' - x') + f_ff(t) - m_h x''``. ``HandParams.behaviour``:
 
 - ``semi_random``: ``x_r = ramp(t) * offset + amplitude * n(t)``, ``n`` unit-variance Gaussian
-  noise band-limited to [band_low_hz, band_high_hz] (4th-order Butterworth band-pass, zero mean)
-  and rolled off above ``rolloff_hz`` (2nd-order Butterworth low-pass; 0: none), the thesis's
-  "semi-random" transparency excitation (40 s per run). The reference is a depth, the same at
-  every wall (``depth_reference``): the push rises with the wall.
-- ``push_hold``: ``x_r = ramp(t) * offset`` held, plus a rectangular force pulse of
-  ``perturbation_n`` lasting ``perturbation_s`` at ``perturbation_at_s``: the vibration protocol.
-- ``none``: no hand (zero force; the device moves only under its actuator).
+  noise band-passed to [band_low_hz, band_high_hz] (4th-order Butterworth) and rolled off above
+  ``rolloff_hz`` (2nd order; 0: none); a depth, the same at every wall (``depth_reference``);
+- ``push_hold``: ``x_r = ramp(t) * offset`` held, plus a force pulse ``f_ff`` of ``perturbation_n``
+  for ``perturbation_s`` at ``perturbation_at_s``; ``none``: no hand (zero force).
 
-The reference is generated block by block from a seeded generator, so an unbounded real-time run
-and a batch run of the same seed see the same hand, whatever the block length (the noise filter
-carries its state across blocks; the samples are bit-identical). Blocks are short
-(``BLOCK_S``) and a real-time device generates the next one ahead (``prepare``) while it waits for
-a command: a one-second block generated inside a control period (about 0.3 ms of numpy, more on a
-busy machine) made the command of every thousandth cycle late.
+Generated in ``BLOCK_S`` blocks from a seeded generator, bit-identical whatever the block length
+(batch and real time see one hand); ``prepare`` makes the next ahead (docs/design/timing.md).
 """
 
 from __future__ import annotations

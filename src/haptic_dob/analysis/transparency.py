@@ -1,17 +1,14 @@
 """Transparency of a rendered impedance from motion and hand-force records (thesis 2.1.4, 7.2).
 
-H1 estimator (Fite et al.): ``Z_hat(f) = S_xF(f) / S_xx(f)``, the cross-spectral density of motion x
-(position, m) and hand force F (N) over the auto-spectral density of x, both by Welch averaging
-(``scipy.signal.csd`` / ``welch``): Hann window, 50 % overlap, each segment's mean removed,
-``segment_s`` long segments. By default (``segment_s`` None, ``segment_for``) 4 s if that still
-averages ``MIN_AVERAGES`` (16) segments, so the H1 magnitude's random error stays near 9 %
-(0.75 dB) at a coherence of 0.8 (Bendat and Piersol, "Random Data"), else 2 s: 4 s (0.25 Hz
-bins, 18 averages) for chapter 7's 38 s, 2 s for 18 s or a shorter record.
+H1 estimator (Fite et al.): ``Z_hat(f) = S_xF(f) / S_xx(f)`` of motion x (position, m) and hand
+force F (N), both by Welch averaging (``scipy.signal.csd`` / ``welch``): Hann window, 50 %
+overlap, each segment's mean removed, ``segment_s`` long segments; by default (``segment_for``)
+4 s if that still averages ``MIN_AVERAGES`` (16) segments, else 2 s (why:
+docs/recording-and-analysis.md).
 
 Transparency ``T(f) = Z_hat / Z_d``. The bandwidth is the first frequency, from the lowest non-zero
-bin up to ``fmax``, where |T| leaves the +-3 dB band [10^(-3/20), 10^(3/20)] = [0.708, 1.413]; the
-crossing is interpolated linearly in |T| between the two bins around it. If |T| never leaves
-the band below ``fmax`` the bandwidth is reported as ``fmax`` with ``band_limited_by_fmax`` set.
+bin up to ``fmax``, where |T| leaves the +-3 dB band [0.708, 1.413], interpolated linearly in |T|
+between the two bins around it; ``fmax`` with ``band_limited_by_fmax`` set if it never leaves.
 The average normalized impedance error is the mean of ``|Z_d - Z_hat| / |Z_d|`` over the bins
 inside the band, in percent. The magnitude-squared coherence of x and F comes with it.
 """

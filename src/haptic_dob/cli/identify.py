@@ -3,18 +3,15 @@
 Reads the joint states of a recorded session (MCAP or sqlite3; ours or ``ros2 bag record``'s;
 ``/joint_states`` alone is enough) and identifies ``m x'' + c x' + Fc sgn(x') = u`` by least
 squares (default) or by the step method under a virtual spring (``--method step``, or
-``thesis_step`` for the thesis's formulas verbatim).
-With ``--urdf FILE --tip-frame F`` it identifies an arm's joint friction instead (viscous and
-Coulomb per joint, beyond the URDF's rigid body; ``haptic_dob.identification.arm_friction``), judged
-on held-out data; with ``--inertial`` too, the arm's whole model (every link's mass, centre of
-mass and inertia, physically consistent, with each joint's armature and friction;
-``haptic_dob.identification.arm_model``), written back as a URDF with ``--write-urdf OUT``. With
-``--axes X,Y,Z`` it identifies a Cartesian device per axis (mass, viscous and Coulomb friction of
-each; ``haptic_dob.identification.per_axis``), the point-mass model of a Force Dimension device
-(``--axes fd_x,fd_y,fd_z``). Prints a table, or one JSON line (``--json``); ``--write-yaml FILE``
-writes the model as a params file (``slide.*``, ``point_mass.*``, or ``urdf.viscous_n_m_s_per_rad``
-and ``urdf.coulomb_n_m``, of the observer and
-the controller, the nodes that assume a model) to load after the session's config.
+``thesis_step`` for the thesis's formulas verbatim). ``--urdf FILE --tip-frame F``: an arm's
+joint friction beyond the URDF's rigid body (``identification.arm_friction``), judged on held-out
+data; with ``--inertial``, the arm's whole physically consistent model with each joint's armature
+and friction (``identification.arm_model``), written as a URDF by ``--write-urdf OUT``.
+``--axes X,Y,Z``: a Cartesian device per axis (``identification.per_axis``; a Force Dimension
+device: ``--axes fd_x,fd_y,fd_z``). Prints a table, or one JSON line (``--json``);
+``--write-yaml FILE`` writes the model as the observer's and controller's params file
+(``slide.*``, ``point_mass.*`` or ``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``), to
+load after the session's config.
 """
 
 from __future__ import annotations

@@ -3,20 +3,15 @@
 
 ROS-free (numpy/scipy/the model's pinocchio). The rigid-body part comes from the arm's model (its
 URDF's masses and inertias, friction left out); what the measured effort has beyond it is fitted
-per joint as viscous plus Coulomb friction by least squares, with the filters the 1-DOF
-identification uses (``haptic_dob.identification.filters``). The speed ``v_c`` over which the
-Coulomb friction turns is found by a search over a grid (least squares for ``b`` and ``Fc`` at each
-value, the smallest residual wins; then refined between that value's neighbours by scipy's
-bounded scalar search), on every sample but the filters' ends, slow ones included:
-they are where it shows (a sign model errs by up to ``2 Fc`` there, at every reversal). A turn
-lasts a few milliseconds, which the fit's low-pass (``cutoff_hz``, for the accelerations' noise)
-smears over tens: where the encoders resolve speeds well below the turn's, the search may judge
-each candidate through a wider low-pass (``turn_cutoff_hz``), ``b`` and ``Fc`` still fitted
-through the usual one.
+per joint as viscous plus Coulomb friction by least squares, with the 1-DOF identification's
+filters (``haptic_dob.identification.filters``). ``v_c`` is searched over a grid (``b`` and
+``Fc`` by least squares at each, the smallest residual wins, refined by scipy's bounded scalar
+search), on every sample but the filters' ends, slow ones included: reversals are where it
+shows. The search may judge each candidate through a wider low-pass (``turn_cutoff_hz``) than
+the fit's (``cutoff_hz``); why: docs/recording-and-analysis.md, "Identifying the device model".
 
-The fit uses the first ``1 - holdout`` of the record; the rest is held out: each joint reports
-the RMS of what the rigid-body model leaves unexplained there without friction and with the
-fitted friction, so the fit is judged on data it has not seen.
+The fit uses the first ``1 - holdout`` of the record; on the rest each joint reports the RMS of
+what the rigid-body model leaves unexplained without and with the fitted friction.
 """
 
 from __future__ import annotations

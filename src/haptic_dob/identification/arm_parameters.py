@@ -8,11 +8,10 @@ viscous and Coulomb friction (``<joint>.armature``, ``.viscous``, ``.coulomb``).
 Coulomb term (a filtered sign or ``tanh(q' / v_c)``).
 
 Base parameters (``base_set``): the standard columns, taken in order over many states, that are
-not in the span of the columns before them (a zero column, a body's mass that no joint lifts, is
-in every span); each dependent parameter is carried by the base ones, ``beta = theta_b + K
-theta_d``. Visibility (``visibility``): how well a record determines each base parameter (the
-variance of its least-squares estimate per sample, all others free) against how well motion
-across the joints' ranges (``reference_states``) does: the ratio of the two variances.
+not in the span of the ones before (a body's mass that no joint lifts is in every span); the
+dependent ones are carried by them, ``beta = theta_b + K theta_d``. Visibility (``visibility``):
+the variance of each base parameter's least-squares estimate per sample over a record, others
+free, against the same over motion across the joints' ranges (``reference_states``): their ratio.
 """
 
 from __future__ import annotations

@@ -1,28 +1,17 @@
 """Identification of the 1-DOF device model ``m x'' + c x' + Fc sgn(x') = u`` from a record.
 
 ROS-free (numpy/scipy); the input is what a driver's ``joint_states`` carries: the encoder
-position of each sample k and the effort applied over [k-1, k). The methods (thesis ch. 4.2):
+position of each sample k and the effort applied over [k-1, k). The methods (thesis ch. 4.2;
+details and figures: docs/recording-and-analysis.md, "Identifying the device model"):
 
-- ``least_squares`` (default), on any excitation with motion (steps, chirps, a hand's motion):
-  position low-passed by a zero-phase Butterworth filter, velocity and acceleration its
-  derivatives (Savitzky-Golay), the effort filtered the same way, then ``[a, v, sgn v] theta =
-  u`` over the samples that move (``|v| > min_speed``), decimated to about one sample per
-  filter time constant so that the standard errors are not those of correlated residuals. A
-  Stribeck term ``sgn(v) exp(-(v/vs)^2)`` (the best ``vs`` of a grid, kept where significant)
-  takes the friction above Fc at low speed, which Fc and c would otherwise absorb; the model
-  returned leaves it out.
-- ``step``, the thesis's method: under a virtual spring, a force step A; the swings' extrema,
-  the natural frequency from their timing, ``m = k / wn^2``, ``c = 2 zeta sqrt(k m)``. Where the
-  effort holds the spring (``u = b - k x``, a rendered spring: the thesis's case), k and the
-  equilibrium come from it, and the swings' decay gives both the damping ratio (a ratio per
-  half swing) and Coulomb friction (it moves each half swing's equilibrium by Fc/k against the
-  motion: a constant decrement); the spring, held over each sample period T, lags T / 2, and
-  the ``k T / 2`` of damping that lag takes is added back. It needs two swings (one that stops
-  on friction or is cut short is refused). Without a spring in the effort, the thesis's
-  formulas.
-- ``thesis_step``, the thesis's formulas verbatim: ``k = A / x_ss``, the damping ratio from the
-  first overshoot, the natural frequency from the time to the first peak, no Coulomb friction
-  (which then reads as damping).
+- ``least_squares`` (default), on any excitation with motion: position, its derivatives
+  (Savitzky-Golay) and the effort through the same zero-phase Butterworth low-pass, then
+  ``[a, v, sgn v] theta = u`` over the samples that move (``|v| > min_speed``), decimated to
+  about one sample per filter time constant; a Stribeck term, kept where significant, takes the
+  friction above Fc at low speed and is left out of the model returned.
+- ``step`` (the thesis's method) under a virtual spring: k from the effort's spring, the damping
+  ratio and Fc from two swings' decay, ``m = k / wn^2``, ``c = 2 zeta sqrt(k m)``.
+- ``thesis_step``: the thesis's formulas verbatim, no Coulomb friction (``step`` without a spring).
 """
 
 from __future__ import annotations

@@ -5,14 +5,13 @@ Master end (``/master``): ``ee_pose`` + ``ee_twist`` of sample k and the slave's
 sample k to the slave. Slave end (``/slave``): ``ee_pose`` + ``ee_twist`` + the contact force
 (``wrench_estimate``, or ``wrench_measured`` with ``teleop.force_source: sensor``) of sample k
 and the master's newest message -> ``pose_desired`` k (the point the slave's controller tracks)
-and the message of sample k to the master. The two ends talk on ``/teleop/to_slave`` and
+and the message of sample k to the master. The ends talk on ``/teleop/to_slave`` and
 ``/teleop/to_master`` (reliable, in order); each applies the channel's delay, jitter and loss to
 what it receives, and the passivity control to its port (``haptic_dob.teleop.ends``).
 
-``wait_for_peer`` (lockstep): sample k waits until every message of the peer that can be due by
-k has come (the peer's sample ``k - delay``), so the graph reproduces the batch run; a peer that
-stalls stalls the loop. Off (real time): it uses what has come. A sample answered already is
-answered again with the same output (a lockstep re-send).
+``wait_for_peer`` (lockstep): sample k waits for the peer's samples up to ``k - delay``, so the
+graph reproduces the batch run (a peer that stalls stalls the loop); off (real time), it uses
+what has come. A sample answered already is answered again with the same output (a re-send).
 """
 
 from __future__ import annotations

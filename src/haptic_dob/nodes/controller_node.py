@@ -2,24 +2,16 @@
 
 Inputs: ``wrench_desired`` (the wall), ``joint_states`` (for J(q); not subscribed when the model's
 Jacobian is constant, as on the slide), and, as the mode needs them, ``wrench_measured`` (CL) or
-``wrench_estimate`` (DOB). Command k goes out as soon as every input
-of stamp k the mode needs has arrived, labelled with its stamp and the session's command token
-(``effort@<ns>#<token>``: the device takes commands from another process by it). ``mode``, ``kf``
-and ``max_force_n`` change at run time: the next command uses the new law, with no other state to
-carry (bumpless). A switch to CL or DOB is refused while its force input is not flowing (the
-observer must be warm before DOB takes over).
+``wrench_estimate`` (DOB). Command k goes out as soon as every input of stamp k the mode needs
+has arrived, labelled with its stamp and the session's command token (``effort@<ns>#<token>``).
+``mode``, ``kf`` and ``max_force_n`` change at run time, bumpless (the next command uses the new
+law); a switch to CL or DOB is refused while its force input is not flowing.
 
-Fallback: when the force input the mode needs stops (the observer died in DOB, the sensor stream in
-CL) -- its newest sample is more than ``input_timeout_s`` of sample time older than the cycle --
-the controller renders with ``fallback`` (``zero``: no force; ``OL``: the wall force alone), says
-so, and returns to its mode once the input flows again (warm, as for a switch). Right after a
-switch the new input may lag behind the cycle (off the lockstep critical path until then): while
-it still flows the controller waits for it instead of falling back, so the switch stays bumpless.
-Only sample stamps decide, never the wall clock, so a lockstep run stays deterministic under any
-load (a dead input stalls it instead, and the device and controller say which input is missing);
-in real time the device's watchdog zeroes the force while the controller waits.
-Without the wall force (``wrench_desired``) it sends nothing and the device's watchdog zeroes the
-effort. ``/diagnostics`` reports the mode, the fallback state and the inputs still awaited.
+Fallback: when the mode's force input stops (its newest sample more than ``input_timeout_s`` of
+sample time older than the cycle) it renders ``fallback`` (``zero`` or ``OL``), says so, and
+returns to its mode once the input flows again; only sample stamps decide, never the wall clock
+(docs/safety.md). Without ``wrench_desired`` it sends nothing and the device's watchdog zeroes
+the effort. ``/diagnostics`` reports the mode, the fallback state and the inputs still awaited.
 """
 
 from __future__ import annotations

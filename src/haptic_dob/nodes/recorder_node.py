@@ -2,20 +2,16 @@
 
 - Subscribes raw (serialized CDR) and writes the bytes as they are: reliable ``qos.RECORD`` for
   the loop's topics, the parameter-events profile for ``/parameter_events``, reliable volatile
-  otherwise. Bag time: the session's (``log_time``; ``/clock`` where no loop topic is recorded)
-  or receive time.
-- Snapshots the parameters of every node in its ``namespaces`` (as a ``ParameterEvent`` on
+  otherwise; bag time is the session's (``log_time``) or receive time. Stores each topic's
+  offered QoS in the bag, as ``ros2 bag record`` does.
+- Snapshots the parameters of every node in its ``namespaces`` (a ``ParameterEvent`` on
   ``/parameter_events``), nodes that start later when they appear.
-- Publishes ``recorder/progress`` (``std_msgs/Header``: newest stamp written over the flowing
-  topics, its name in ``frame_id``) at ``progress_rate_hz``: a lockstep device holds the loop
-  while that lags, and sends sample 0 only once every reader matched, so nothing is lost.
-  Volatile, so a late ``ros2 topic echo`` is told of no loss (docs/recording-and-analysis.md).
-- Stores each topic's offered QoS (from the graph) in the bag, as ``ros2 bag record`` does.
+- Publishes ``recorder/progress`` (``std_msgs/Header``: newest stamp written, its topic in
+  ``frame_id``; volatile) at ``progress_rate_hz``: a lockstep device holds the loop while it lags.
 - On SIGINT/SIGTERM (or after ``duration_s``) takes what is still queued (at most
   ``drain_timeout_s``), closes the bag readable and logs per topic what it received and wrote.
 
-The ROS-free parts (topics, the bag, counts, snapshots) are in ``haptic_dob.recorder``;
-docs/recording-and-analysis.md has the details.
+ROS-free parts: ``haptic_dob.recorder``; details: docs/recording-and-analysis.md.
 """
 
 from __future__ import annotations

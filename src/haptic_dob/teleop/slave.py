@@ -2,17 +2,16 @@
 
 Per cycle, with the joint state of sample k and the point ``x_d`` to track (m, base frame):
 
-1. one damped-least-squares step of differential inverse kinematics moves the joint target
-   ``q_d`` toward ``x_d``: ``dq = J# (x_d - p(q_d)) + (I - J# J) k_n (q_0 - q_d)``,
-   ``J# = J^T (J J^T + lambda^2 I)^-1`` at ``q_d`` (the null-space term pulls toward the start
-   posture ``q_0``), ``dq`` limited to ``max_joint_speed_rad_s`` per period;
+1. a damped-least-squares inverse-kinematics step moves the joint target ``q_d`` toward ``x_d``:
+   ``dq = J# (x_d - p(q_d)) + (I - J# J) k_n (q_0 - q_d)``, ``J# = J^T (J J^T + lambda^2 I)^-1``
+   at ``q_d``, ``q_0`` the start posture, ``dq`` limited to ``max_joint_speed_rad_s`` per period;
 2. ``tau = K (q_d - q) - B q' + G(q)`` (the controller's model's gravity), saturated per joint at
    the model's effort limits (``haptic_dob.core.control.saturate``).
 
 Gains: ``K = D(q_0) w^2``, ``B = 2 zeta w D(q_0)``, ``w = 2 pi bandwidth_hz`` (per-joint gains,
 when given, are diagonal); ``q_d``, ``q_0`` start at the first sample's positions. With
-``trajectory_path`` (an excitation file) it plays that by computed torque instead (``play``).
-Why full matrices, the target in contact, the playing law: docs/design/teleoperation.md.
+``trajectory_path`` (an excitation file) it plays that by computed torque (``play``; why the
+full matrices, the target in contact and this law: docs/design/teleoperation.md).
 """
 
 from __future__ import annotations

@@ -1,42 +1,17 @@
 """A simulated multi-DOF arm (the PHANToM 1.5, any URDF arm): plant, encoders, sensor and hand.
 
-Plant: any ``DeviceModel``, ``D(q) q'' + C(q, q') q' + G(q) + friction(q') = tau + J^T F_tip``,
-with ``F_tip`` the hand's force plus an optional known external force at the end-effector point.
-
-Integration: ``substeps`` classical Runge-Kutta (RK4) steps per control period (10 at 1 kHz:
-10 kHz), with the actuator effort held over the whole period (zero-order hold), and the hand's
-reference and the external force held over each sub-step. The dynamics come from the model
-(``haptic_sim.arm.dynamics``: one pass for pinocchio models) and a linear solve. A torque-free,
-frictionless run of the PHANToM keeps its energy to 9e-13 J over 2 s (kinetic energy up to
-0.65 J; test_phantom).
-
-Joint friction: the model's, its Coulomb sign smoothed to ``Fc tanh(q' / eps)`` (RK4 cannot
-integrate a sign; ``arm_dynamics.coulomb_smoothing`` gives eps): slower, a joint creeps.
-
-Actuators: each joint's effort is saturated on its own. The limits are ``joint_effort_limits``
-when given, else the model's own (a URDF's ``<limit effort>``) when it has them for every joint,
-else ``max_force_n`` times each column norm of J at the start pose (at least 1 cm): the joint
-effort that gives ``max_force_n`` at the tip there (``haptic_sim.arm.params`` gives the defaults).
-
-Encoders: joint angles quantized to ``encoder_resolution_rad`` (0 = ideal); velocity is the
-backward difference of the encoder readings, as a driver computes it.
-
-Hand (3-D, ``haptic_sim.hand_space``): a mass ``m_h`` moving with the handle, held by a grip
-spring and damper to a reference ``x_r(t) = p0 + u r(t) + e1 r1(t) + e2 r2(t)``: ``p0`` the start
-position of the end effector, ``u`` the push direction (``hand_direction``), ``r(t)`` the 1-D
-reference of ``hand.py`` (push-and-hold or semi-random, with its ramp and force pulse along
-``u``) and ``r1``, ``r2`` semi-random motions across ``u`` (``hand_lateral_amplitude_m``, default
-0). Force on the device ``F_h = k_h (x_r - p) + b_h (x_r' - p') + f_ff u - m_h p''``; the hand
-mass enters the dynamics exactly (``D + m_h J^T J``, bias ``+ m_h J^T J' q'``). ``behaviour:
-none``: no hand.
-
-Contact (``contact``, ``haptic_sim.arm.contact``): a wall the end effector touches, its force
-evaluated at every integration stage from the stage's tip point and velocity and added to the
-external force; ``contact_force_true`` is its value at the sample's true state, and the sample's
-``hand_force`` then carries the external force at that state (a teleoperation slave's true contact).
-
-Force sensor: three ``ForceSensor`` axes (noise, first-order bandwidth, bias) at the handle,
-reading the total external force on the end effector (hand, external force and contact).
+Plant: any ``DeviceModel``, ``D(q) q'' + C(q, q') q' + G(q) + friction(q') = tau + J^T F_tip``;
+``F_tip`` sums the hand's force, an optional known external force and the contact's
+(``haptic_sim.arm.contact``, at every integration stage; ``contact_force_true`` at the sample).
+``substeps`` RK4 steps per control period (10 at 1 kHz), the effort held over the period, the
+hand's reference and the external force over each sub-step. Coulomb friction is smoothed to
+``Fc tanh(q' / eps)`` (``arm_dynamics.coulomb_smoothing``; docs/design/friction.md).
+Each joint's effort is saturated at ``joint_effort_limits``, else the model's limits, else the
+effort that gives ``max_force_n`` at the tip at the start pose (``haptic_sim.arm.params``).
+Encoders quantize the joint angles to ``encoder_resolution_rad`` (0 = ideal); velocity is their
+backward difference. Hand (``haptic_sim.hand_space``): a mass ``m_h`` moving with the handle
+(``D + m_h J^T J``) held by a grip spring and damper to its reference (``behaviour: none``: no
+hand). Force sensor: three ``ForceSensor`` axes reading the total external force at the handle.
 """
 
 from __future__ import annotations

@@ -1,25 +1,17 @@
 """``haptic-experiment``: the thesis's experiments through the node graph, and a report.
 
-Parts (``--parts``, all by default):
+Parts (``--parts``, all by default; docs/reproduction.md): ``ch4`` identification and model
+verification, ``ch5`` the observer against the force sensor, ``ch7`` transparency, ``ch6``
+vibration onset, ``slave`` the teleoperation slave's model (node graph, recorded); ``map`` the
+stability map, ``dob`` the DOB wall at Kf = 100, ``sweeps`` Table 7.1's cells against the
+parameter responsible, ``phantom`` thesis 5.2 (batch).
 
-- ``ch4``: identification (a 2.4 N step under an 80 N/m spring) and model verification (1.6 N and
-  3.2 N steps, a 0.6 N 2 Hz sine) through the node graph, recorded and identified from the bags;
-- ``ch5``: thesis 5.3, the observer's estimate against the force sensor in free space and against
-  an 800 N/m wall, through the node graph;
-- ``ch7``: transparency, OL / CL Kf=2 / DOB Kf=1 / DOB Kf=25 on walls of 80-2400 N/m, 40 s of
-  semi-random hand motion each, run through the node graph in lockstep and recorded;
-- ``ch6``: vibration onset through the node graph (push-and-hold protocol, pulse response);
-- ``map``: the stability map (onset against Kf, Z-width against wall damping), batch sweeps;
-- ``dob``: why the thesis's DOB wall stayed quiet at Kf = 100 (batch, the simulator's knobs);
-- ``phantom``: thesis section 5.2 on the PHANToM 1.5 (batch).
-
-Graph runs go ``--workers`` at a time, each on a ROS domain of its own (by default as many as the
-free CPUs carry: a run keeps two processes busy, its composed loop and its recorder; batch jobs
-one each); a run whose bag is complete is not run again, so an interrupted experiment resumes
-(``--fresh`` starts over). The
-bags are analysed as ``haptic-analyze`` does (``runs/*/analysis.json``), and ``report.md`` with
-its figures and ``results.json`` is written to ``--out``. ``--quick`` runs only OL, CL Kf=2 and
-DOB Kf=1 at 800 N/m for 40 s (the demo).
+Graph runs go ``--workers`` at a time, each on a ROS domain of its own (default: as many as the
+free CPUs carry, a graph run or a batch job counting one); a run whose bag is complete is not
+run again, so an interrupted experiment resumes (``--fresh`` starts over). The bags are analysed
+as ``haptic-analyze`` does (``runs/*/analysis.json``), and ``report.md`` with its figures and
+``results.json`` are written to ``--out``. ``--quick`` runs only OL, CL Kf=2 and DOB Kf=1 at
+800 N/m for 40 s (the demo).
 """
 
 from __future__ import annotations

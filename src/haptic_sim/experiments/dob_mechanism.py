@@ -1,21 +1,13 @@
 """Why the thesis's DOB wall (Kf = 100) kept quiet to 2400 N/m: the mechanism, with its knobs.
 
-The force-feedback bound ``2 b / (T (1 + Kf))`` is 25 N/m at Kf = 100, and the linear loop model
-(``haptic_dob.analysis.linear_loop``) says the DOB loop is unstable at every wall. Yet the thesis
-saw sustained vibration only at 3200 N/m. Chapter 6's tap protocol
-(``haptic_sim.slide.stability.TAP``: the light grip, the configuration's plant and model with their
-friction, a 3 N x 20 ms tap) finds
-the first wall that keeps vibrating through the graph; the study here repeats it in batch and
-varies what the linear model leaves out or what it cannot decide:
-
-- the actuator saturation (4 N) and the observer's output limit (4 N): the high-gain loop is
-  linear only in a band of ``2 u_max / (Kf K)`` of position around equilibrium, so a growing
-  oscillation soon saturates and the loop acts as a relay of bounded amplitude;
-- Coulomb friction (the plant's and the model's, or none): a relay chatter of small amplitude
-  sticks, and the slide stays where the wall's push and the hand balance;
-- the observer gain ``c``, the configuration's among others: the faster the observer, the stiffer
-  the wall it keeps quiet, up to the gain above which the estimate's share of the last command
-  makes the loop chatter at the sample rate (``chatter_gain``, about ``2 m / (Kf T)``).
+The linear loop model (``haptic_dob.analysis.linear_loop``) says the DOB loop at Kf = 100 is
+unstable at every wall, yet the thesis saw sustained vibration only at 3200 N/m. Chapter 6's tap
+protocol (``haptic_sim.slide.stability.TAP``: the light grip, the configuration's plant and
+model with their friction, a 3 N x 20 ms tap) finds the first wall that keeps vibrating; the
+study repeats it in batch and varies what the linear model leaves out or cannot decide: the
+actuator saturation and the observer's output limit (4 N each), Coulomb friction (the plant's
+and the model's, or none), the observer gain ``c`` up to ``chatter_gain`` (about
+``2 m / (Kf T)``), and the hand's grip. Why each matters: docs/design/stability.md.
 
 ``residual`` (``haptic_sim.slide.stability``) measures what is left 2 to 3 s after the tap; a wall
 vibrates when the hand would feel it (``felt``: its peak above the vibrotactile detection

@@ -1,21 +1,16 @@
 """The observer gain per force gain Kf: a rule, not a fit to Table 7.1.
 
 The thesis names no observer gain for the slide (only c = 2 for the PHANToM, 5.2.1). Two
-criteria the thesis's own experiments imply, applied in this order:
+criteria the thesis's own experiments imply, applied in this order (docs/models.md):
 
 1. **Accuracy (thesis 5.3).** The gain whose estimate is closest to the handle's force sensor in
-   chapter 5.3's two sessions (the observer beside an OL loop while the semi-random hand moves
-   the slide in free space and pushes into an 800 N/m wall): the RMS difference of estimate and
-   sensor over both, after the hand's ramp-in (``best_gain``). In OL the estimate does not act
-   on the loop, so both sessions run once and the observer is replayed over their samples for
-   every candidate gain.
-2. **No chatter at that Kf.** With force feedback the observer's estimate carries about
-   ``-(c T / 2 m)`` of the last command, so above ``chatter_gain`` (about ``2 m / (Kf T)``,
-   ``haptic_dob.analysis.linear_loop``) the command alternates its sign every period. The gain
-   at Kf is the accuracy gain, or the largest whole gain below that limit if it is smaller
-   (``gain_for``).
-
-Nothing here reads Table 7.1 or 7.2 (``test_held_out``).
+   chapter 5.3's two sessions (OL, the semi-random hand in free space and against an 800 N/m
+   wall): the RMS difference of estimate and sensor over both, after the hand's ramp-in
+   (``best_gain``). In OL the estimate does not act on the loop, so both sessions run once and
+   the observer is replayed over their samples for every candidate gain.
+2. **No chatter at that Kf.** The accuracy gain, or the largest whole gain below
+   ``chatter_gain`` (about ``2 m / (Kf T)``, ``haptic_dob.analysis.linear_loop``) if smaller
+   (``gain_for``). Nothing here reads Table 7.1 or 7.2 (``test_held_out``).
 """
 
 from __future__ import annotations

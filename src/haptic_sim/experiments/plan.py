@@ -1,22 +1,17 @@
 """What the reproduction runs: the thesis's chapter 7 and chapter 6 sessions as node-graph runs.
 
 Chapter 7 (transparency): OL, CL with Kf = 2, DOB with Kf = 1 and Kf = 25 on walls of 80, 800,
-1600 and 2400 N/m (thesis 7.1), 40 s of semi-random hand motion each (the same seed for every
-cell, so every controller meets the same hand). The hand pushes to the configuration's depth
-at every wall (``haptic_sim.hand.depth_reference``); DOB takes the observer gain of its Kf
-(``observer_gain.gain_at``). OL and CL runs leave the observer out (they do not use it) and the
-controller subscribes only to its own mode's input; the recorder records what the analysis reads.
-The quick variant (the demo) runs OL, CL Kf = 2 and DOB Kf = 1 at 800 N/m, 40 s each (as
-chapter 7: the 4 s spectral segments need the whole session's averages).
+1600 and 2400 N/m (thesis 7.1), 40 s of semi-random hand motion each, the same seed and depth
+(``haptic_sim.hand.depth_reference``) for every cell; DOB takes its Kf's observer gain
+(``observer_gain.gain_at``). OL and CL runs leave the observer out, the controller subscribes
+only to its mode's input, and the recorder records what the analysis reads. The quick variant
+(the demo): OL, CL Kf = 2 and DOB Kf = 1 at 800 N/m, 40 s each (the 4 s segments need it).
 
-Chapter 6 (vibration onset, through the graph), the thesis's user trying to provoke vibration:
-a light 20 N/m grip pushing 1 N into the wall, 4-4.5 s per wall, in two protocols of
-``haptic_sim.slide.stability``. The linear one (a 0.5 N x 5 ms pulse, Coulomb friction off in the
-plant and in the model: the premise of the passivity bounds the thesis compares its OL and CL onsets
-with) for OL and CL with Kf = 2 over the thesis's walls plus points that bracket their bounds, and
-DOB with Kf = 100 at two walls (linearly unstable at every wall). The tap (``TAP``: the
-configuration's plant and model as they are, a 3 N x 20 ms tap) for all three: OL and CL at
-their thesis walls (with friction, no wall keeps vibrating), DOB at the thesis's walls and between.
+Chapter 6 (vibration onset; docs/reproduction.md): a light 20 N/m grip pushing 1 N into the
+wall, 4-4.5 s per wall, in ``haptic_sim.slide.stability``'s two protocols. The linear one (a
+0.5 N x 5 ms pulse, Coulomb friction off in plant and model) for OL and CL Kf = 2 over the
+thesis's walls and points that bracket their bounds, and DOB Kf = 100 at two walls; the tap
+(``TAP``, friction kept) for OL and CL at their thesis walls, DOB at the thesis's and between.
 """
 
 from __future__ import annotations

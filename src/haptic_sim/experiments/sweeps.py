@@ -1,31 +1,17 @@
 """Table 7.1's cells that stay off, each swept against the parameter responsible (batch).
 
-- **2400 N/m against the hand's grip damping.** The bandwidth is the first frequency where the
-  rendered impedance leaves the 3 dB band around the wall's. At 2400 N/m OL renders the wall
-  soft across the whole band, so that edge is ill-conditioned and follows the hand's grip.
-- **OL at 2400 N/m, a loose grip, against Coulomb friction.** The thesis's user could sustain
-  OL vibration at 2400 N/m (6.3); the simulated friction stops it. Without friction (plant and
-  model) and without grip damping the wall keeps vibrating through the session: what that does
-  to its band.
-- **80 N/m against the hand's depth.** The depth-regulating hand pushes a soft wall only a
-  little (0.47 N at 80 N/m, thesis 7.3.2: "close to the frictional force"); the reference's
-  offset and amplitude scaled together show what a deeper push does to the friction-dominated
-  cells.
-- **Every wall against the observer gain (DOB).** For a large Kf the rendered impedance rises
-  past +3 dB near the observer's corner ``c / (2 pi m)``, so DOB Kf = 25's band follows c; the
-  gain rule (``observer_gain``) gives Kf = 25 the fastest gain that does not chatter.
-- **Every wall against the plant's low-speed friction (DOB).** The thesis (7.3.3.1) blames the
-  high-gain DOB's errors on friction at low speed that the observer's model leaves out; the
-  breakaway ratio is swept up to 2.5 (0.6 N), where chapter 4.3's 0.6 N sine no longer breaks
-  the slide away (the thesis's device tracked it).
-- **1600 and 2400 N/m against the force sensor's bandwidth (CL).** CL's band follows the mass line
-  ``m / (1 + Kf)`` above the thesis's 4.5 Hz; a slower sensor lowers it only when it also lowers
-  the CL onset of chapter 6's linear protocol below the thesis's 800 N/m (the onset column).
+- 2400 N/m against the hand's grip damping (OL renders that wall soft across the band, so its
+  band edge is ill-conditioned and follows the grip); OL there with a loose grip against
+  Coulomb friction (without it, in plant and model, the wall keeps vibrating);
+- 80 N/m against the hand's depth (offset and amplitude scaled together; thesis 7.3.2);
+- every wall against the observer gain (DOB: for a large Kf the rendering rises past +3 dB near
+  the corner ``c / (2 pi m)``) and against the plant's breakaway friction, up to 2.5 times
+  Coulomb (thesis 7.3.3.1);
+- 1600 and 2400 N/m against the force sensor's bandwidth (CL), with chapter 6's CL onset beside.
 
-Each sweep's first value is the chapter-7 session's (read from the configuration, per Kf for
-the observer gain); the cells show the bandwidth, coherence, the rendering's magnitude at the
-first bin and up to 5 Hz, and the time at the force limit, so the report shows the mechanism
-rather than a constant fitted to the table.
+Each sweep's first value is the chapter-7 session's (from the configuration; per Kf for the
+observer gain); the cells show bandwidth, coherence, the rendering's magnitude at the first bin
+and up to 5 Hz, and the time at the force limit: the mechanism, not a constant fitted to the table.
 """
 
 from __future__ import annotations

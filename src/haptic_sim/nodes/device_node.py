@@ -1,34 +1,17 @@
 """device_node: a simulated haptic device on the lab network, in lockstep or in real time.
 
-Publishes per sample k (stamped ``k * T`` in lockstep, the system clock when taken in real time):
-``ee_pose``, ``ee_twist``, ``joint_states`` (position,
-velocity, and the effort applied over [k-1, k) after saturation), ``wrench_measured`` (the handle
-force sensor), ``sim/hand_wrench`` (the true hand force, for evaluation) and ``/clock`` (the
-stamp as ROS time, in both clock modes; these two only while someone reads them). Takes
-``effort_command`` (Float64MultiArray in joint order).
+Per sample k (stamped ``k * T`` in lockstep, the system clock in real time): ``ee_pose``,
+``ee_twist``, ``joint_states`` (position, velocity, the effort applied over [k-1, k) after
+saturation), ``wrench_measured`` (the handle sensor), and while read ``sim/hand_wrench`` (the
+true hand force) and ``/clock``. Takes ``effort_command`` (Float64MultiArray in joint order).
 
-- lockstep: sample 0 goes out once the nodes in ``wait_for`` are up and matched; sample k+1 only
-  after command k (labelled ``effort@<stamp>``, or unlabelled) arrived. If no command comes within
-  ``lockstep_timeout_s`` the node says so and sends sample k again (every node answers a repeated
-  sample idempotently). While a recorder reports its progress (``recorder/progress``), the device
-  also holds the next sample when the recorder lags more than ``max_recorder_lag_s`` of simulated
-  time, so a recording of a lockstep run never loses a sample. Stops after ``duration_s``
-  (0: never), once a recorder (if any) has written the last sample.
-- realtime: once the ``wait_for`` nodes are up (as in lockstep; ``[]`` starts at once), ticks at
-  ``rate_hz`` on the wall clock's grid and applies the newest valid command; a tick a period or
-  more late is an overrun and the grid points it passed are missed ticks (time never slows: a
-  ``duration_s`` run lasts ``duration_s``, with a sample fewer per missed tick);
-  records whether command k arrived before the next tick, its latency and the overruns
-  (``stats_file``).
+- lockstep: sample 0 once the ``wait_for`` nodes are matched, k+1 after command k (k again after
+  ``lockstep_timeout_s``), held while a recorder lags ``max_recorder_lag_s``; ends after
+  ``duration_s`` (0: never) once the recorder has it all (docs/running.md, "Clock modes").
+- realtime: ticks at ``rate_hz`` on the wall clock's grid, the newest valid command applied.
 
-Safety (every path, both modes): each joint's effort is clamped to ``effort_limits`` (at most the
-actuator's own saturation; changeable at run time); a command of the wrong length or with NaN/inf
-is refused and counts as zero effort (counted, logged once per burst); in real time a watchdog
-zeroes the effort when no valid command came for ``command_timeout_s`` and says so, and the next
-valid command resumes; at shutdown the effort goes to zero first. Only the loop's own controller
-commands it (``haptic_dob.nodes.command_input``; ``open_command_input``, off as on a real device,
-opens it). ``/diagnostics`` reports the loop rate, overruns and missed ticks, the watchdog,
-refused, limited and foreign commands.
+Safety on every path (docs/safety.md): efforts clamped to ``effort_limits``, a bad command counts
+as zero, a watchdog (``command_timeout_s``), zero at shutdown; only its controller commands it.
 """
 
 from __future__ import annotations

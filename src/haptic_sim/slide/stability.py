@@ -1,35 +1,17 @@
 """Vibration onset of a virtual wall in batch simulation: the protocol and the sweep.
 
-Protocol (linear in-contact onset, thesis 6.1 / theory sheet section 4):
+Protocol (linear in-contact onset, thesis 6.1; docs/recording-and-analysis.md, "Vibration onset"):
+``push_n`` (1 N) into the wall through a light grip (``grip_n_per_m``, no hand mass or damping),
+Coulomb friction off in plant and model (``coulomb_n``: a value in both; None: the config's),
+then a ``pulse_n`` (0.5 N) 5 ms pulse at 1.5 s. The growth rate is the slope of ln(envelope) of
+the position about ``push / K`` into the wall over ``observe_s`` (2.5 s), ended at half the
+penetration depth (a wall already oscillating that much vibrates: NaN); the onset stiffness is
+its first zero crossing along the sweep, interpolated. Bound beside it: ``K (1 + Kf) < 2 b / T``.
 
-1. The hand pushes steadily into the wall with ``push_n`` (1 N) through a light grip
-   (``grip_n_per_m`` = 20 N/m, no hand mass, no grip damping): almost a pure force source, so
-   the hand adds neither damping nor inertia (the worst case, as the thesis notes for 5.2.2).
-2. Coulomb friction is off in the plant and in the observer's model by default: with it, small
-   oscillations stick and die out whatever the stiffness (``coulomb_n`` puts a value in both,
-   ``coulomb_n=None`` keeps the configuration's plant and model as they are). Viscous
-   friction, encoder quantization, sensor noise and saturation stay as configured.
-3. After the push has settled (ramp 1 s, pulse at 1.5 s) a force pulse of ``pulse_n`` (0.5 N)
-   for 5 ms excites the contact mode.
-4. The envelope growth rate of the position about the static equilibrium (``push / K`` into the
-   wall) over the ``observe_s`` (2.5 s) after the pulse is the slope of ln(envelope)
-   (``haptic_dob.analysis.vibration``), the fit ending where the oscillation reaches half the
-   penetration depth (contact about to be lost). A wall that already oscillates with that
-   amplitude before the pulse (a limit cycle grown from the contact itself) vibrates; its growth
-   rate is not measured (NaN).
-5. The onset stiffness is the first zero crossing of the growth rate along the sweep, linearly
-   interpolated between the last decaying and the first growing stiffness.
-
-``TAP`` is chapter 6's other protocol, for a loop that only a nonlinearity keeps quiet (DOB at
-Kf = 100 is linearly unstable at every wall): the same hand and push, the configuration's friction
-kept, and a tap of 3 N for 20 ms (the thesis's user tried to provoke vibration); a wall vibrates
-when the motion 2-3 s after the tap is one the hand feels (``felt``): its peak (``sqrt 2`` times
-the RMS about the slow trend, ``residual``) above the vibrotactile detection threshold at its
-dominant frequency (``detection_threshold_m``). The thesis's user judged "sustained vibrations"
-by feel (6.2), so the criterion is a perceptual one, not the encoder's resolution.
-
-Theory bound beside it: ``K (1 + Kf) < 2 b / T`` (Colgate & Schenkel; thesis 6.3 with Kf), i.e.
-2544 N/m open loop and 848 N/m for CL with Kf = 2 on the thesis's slide.
+``TAP`` (chapter 6's other protocol, docs/reproduction.md), for a loop only a nonlinearity keeps
+quiet: the configuration's friction, a 3 N x 20 ms tap; a wall vibrates when the motion 2-3 s
+later is ``felt``: its peak (``sqrt 2`` times the RMS about the slow trend, ``residual``) above
+``detection_threshold_m`` at its dominant frequency.
 """
 
 from __future__ import annotations

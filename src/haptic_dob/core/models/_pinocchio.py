@@ -97,14 +97,12 @@ class PinocchioModel(DeviceModel):
         joint_names: names of the joint-space coordinates, in order.
         S: constant map from our coordinates to pinocchio's (``q_t = S q``), None = identity.
         gravity: False leaves gravity out (G = 0), e.g. for an observer's model (thesis 5.2.1).
-        viscous: viscous joint friction b (N m s/rad or N s/m), scalar or per joint, >= 0.
-        coulomb: Coulomb joint friction Fc (N m or N), scalar or per joint, >= 0: the joint
-            friction is ``b q' + Fc sgn(q')``.
+        viscous, coulomb: joint friction b (N m s/rad or N s/m) and Fc (N m or N), scalar or
+            per joint, >= 0: ``b q' + Fc sgn(q')``.
         coulomb_speed: v_c (rad/s or m/s), scalar or per joint, >= 0: where > 0 the Coulomb
             term is ``Fc tanh(q' / v_c)`` (a friction that turns over a speed, as identified).
         armature: rotor inertia reflected to each joint (kg m^2 or kg), scalar or per joint,
-            >= 0: added to D's diagonal (pinocchio's ``armature``; ``S`` must then be a
-            permutation).
+            >= 0: added to D's diagonal (pinocchio's ``armature``; ``S`` then a permutation).
     """
 
     def __init__(

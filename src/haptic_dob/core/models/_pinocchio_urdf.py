@@ -1,19 +1,17 @@
 """URDF arms for pinocchio: parse, choose the joints, lock the rest (pinocchio's API stays here).
 
-- revolute and prismatic joints: one coordinate each;
+- revolute and prismatic joints: one coordinate each; fixed joints: merged into their links;
+  meshes: never read;
 - continuous joints (pinocchio's ``RUB``, configuration ``(cos, sin)``): one coordinate, the
-  angle as a joint state carries it (``PinocchioModel`` maps angles to the configuration with
-  ``pinocchio.integrate`` from the neutral configuration);
+  angle as a joint state carries it (``PinocchioModel`` maps it with ``pinocchio.integrate``);
 - mimic joints: pinocchio's own, following their master, never coordinates of their own (they
   move with their master when it is chosen, else they are locked with it);
-- fixed joints: merged into their links; meshes: never read;
 - floating, planar and other multi-DOF joints: refused with the joint's name when they would be
   a coordinate (left out of ``joint_names`` they are locked);
 - ``<dynamics damping friction>``: joint friction; a joint's armature and Coulomb turn in its
   ``<haptic_dob:dynamics armature=".." coulomb_speed=".."/>`` (``URDF_NAMESPACE``).
 
-Every joint that is not chosen is locked at its neutral position (zero angle or offset). What a
-real arm's description holds and how it is used: docs/models.md, "PHANToM 1.5 and URDF arms".
+Joints not chosen are locked at their neutral position (zero angle or offset); docs/models.md.
 """
 
 from __future__ import annotations

@@ -28,15 +28,9 @@ class UrdfModel(PinocchioModel):
         tip_frame: the link or frame whose origin is the end-effector point.
         joint_names: the joints to use, in this order (default: the chain to ``tip_frame``).
         gravity: False leaves gravity out of the model.
-        viscous: viscous joint friction (N m s/rad or N s/m), scalar or per joint; None: each
-            joint's ``<dynamics damping>`` from the URDF (0 where it has none).
-        coulomb: Coulomb joint friction (N m or N), scalar or per joint; None: each joint's
-            ``<dynamics friction>`` from the URDF.
-        coulomb_speed: the speed (rad/s or m/s) over which the Coulomb friction turns, scalar or
-            per joint: ``Fc tanh(q' / v_c)``, 0: ``Fc sgn(q')``; None: each joint's
-            ``<haptic_dob:dynamics coulomb_speed>`` from the URDF (0 where it has none).
-        armature: rotor inertia reflected to each joint (kg m^2 or kg), scalar or per joint;
-            None: each joint's ``<haptic_dob:dynamics armature>`` from the URDF (0 where none).
+        viscous, coulomb, coulomb_speed, armature: as ``PinocchioModel``'s, scalar or per
+            joint; None: each joint's from the URDF (``<dynamics damping friction>``,
+            ``<haptic_dob:dynamics coulomb_speed armature>``; 0 where it has none).
         payload_kg: a point mass (kg) at ``tip_frame``'s origin that the URDF does not have.
 
     Raises ``ValueError`` with a clear message for a bad URDF, an unknown frame or joint, or a

@@ -1,23 +1,18 @@
 """Run nodes: one context, one executor, our own SIGINT/SIGTERM handling, a clean shutdown.
 
-Jazzy's ``EventsExecutor.spin()`` does not return on SIGINT/SIGTERM; ``spin_once`` with a timeout
-in a loop that watches a signal flag does, and lets nodes do their shutdown work (a device
-zeroes its effort) before the context goes. Nodes may ask to be woken at a time
-(``next_wakeup``) for real-time ticks, and may say they are ``finished``.
+``spin_once`` with a timeout, in a loop that watches a signal flag (Jazzy's
+``EventsExecutor.spin()`` does not return on SIGINT/SIGTERM; docs/running.md). Nodes may ask to
+be woken at a time (``next_wakeup``) for real-time ticks, and may say they are ``finished``. An
+exception out of any node's callback ends the process, but first every node's ``on_shutdown``
+runs (``last_words``): a device or a bridge to a real driver sends its zero.
 
-An exception out of any node's callback ends the process, but first every node's
-``on_shutdown`` runs (``last_words``): a device or a bridge to a real driver sends its zero.
-
-Nothing published is lost at a clean stop: a process whose nodes all report a ``drain_marker``
-(the observer) first works off the inputs still coming, until the marker stops changing for
-``DRAIN_QUIET_S``, for at most a full input queue of samples (``WORK_OFF_SAMPLES``: in real time
-new samples keep coming; a slow machine takes longer, not fewer). Then every process waits until
-its reliable readers acknowledged what it published, within ``DRAIN_BUDGET_S``. A device node has no
-marker: it zeroes its effort at once.
-
-A process stops when a node finishes (a device at the end of its ``duration_s``), once every node
-of it that ends its run by itself (``finishes_run``) has: two devices composed (a teleoperation
-graph's master and slave) both finish their runs, although one may reach its end first.
+At a clean stop a process whose nodes all report a ``drain_marker`` (the observer) first works
+off the inputs still coming, until the marker stops changing for ``DRAIN_QUIET_S`` and
+``QUIET_SPINS`` spins, for at most a full input queue of samples (``WORK_OFF_SAMPLES``); then
+every process waits until its reliable readers acknowledged what it published, within
+``DRAIN_BUDGET_S``. A device node has no marker: it zeroes its effort at once. A process stops
+when a node finishes, once every node of it that ends its run by itself (``finishes_run``) has: a
+teleoperation graph's master and slave composed both finish their runs.
 """
 
 from __future__ import annotations
