@@ -150,12 +150,13 @@ def inertial_command(
     from haptic_dob.identification.arm_model import Record, identify_arm_model
     from haptic_dob.identification.arm_model_report import table as model_table
 
-    cad = UrdfModel(arm.urdf, arm.tip_frame, arm.joints or None)
+    urdf = installed_urdf(arm.urdf)
+    cad = UrdfModel(urdf, arm.tip_frame, arm.joints or None)
     js = read_joints(bag, topic, cad.joint_names)
     record = Record(js.stamps_ns, js.position, js.effort, js.names)
     try:
         fit = identify_arm_model(
-            read_urdf(arm.urdf), arm.tip_frame, record, turn_cutoff_hz=arm.turn_cutoff_hz
+            read_urdf(urdf), arm.tip_frame, record, turn_cutoff_hz=arm.turn_cutoff_hz
         )
     except IdentificationError as exc:
         raise InputError(f"{bag}: {exc}") from None
@@ -165,7 +166,7 @@ def inertial_command(
         print(model_table(fit, bag))
     if write_urdf:
         note = f"identified from {bag} by haptic-identify, its inertial fit (URDF {arm.urdf})"
-        Path(write_urdf).write_text(fit.urdf(arm.urdf, note), encoding="utf-8")
+        Path(write_urdf).write_text(fit.urdf(urdf, note), encoding="utf-8")
         if not as_json:
             print(f"URDF written to {write_urdf}")
     return 0

@@ -24,6 +24,7 @@ from haptic_dob.identification.arm_urdf import (
 ROOT = Path(__file__).resolve().parents[3]
 ARM7 = ROOT / "config" / "urdf" / "arm7.urdf"
 ARM6 = ROOT / "config" / "urdf" / "arm6_gripper.urdf"
+OMNI = ROOT / "config" / "urdf" / "phantom_omni.urdf"
 ARMATURE = [0.1, 0.12, 0.07, 0.08, 0.06, 0.02, 0.03]
 
 
@@ -44,6 +45,22 @@ def test_the_regressor_times_the_parameters_is_the_models_inverse_dynamics() -> 
     np.testing.assert_allclose(W @ theta, expected.ravel(), atol=1e-10)
     assert ap.layout_of(model).names[:2] == ("link1.m", "link1.mx")
     assert ap.layout_of(model).names[-1] == "joint7.coulomb"
+
+
+def test_a_parallelogram_s_mimic_joints_have_a_regressor() -> None:
+    """The Touch's parallelogram (two mimic joints following the elbow, which pinocchio's
+    regressor refuses): its five bodies' columns by RNEA's differences, ``W theta`` its RNEA with
+    a payload and friction, and the model's own inertias put back."""
+    model = UrdfModel(OMNI, "tip", viscous=0.01, coulomb=0.02, payload_kg=0.012)
+    before = body_parameters(model).copy()
+    x, v, a = states(3, 20, seed=4)
+    W = ap.regressor(model, x, v, a, np.sign(v))
+    links = [b.link for b in bodies(model)]
+    assert links == ["torso", "upper_arm", "lower_arm", "crank", "rear_link"]
+    theta = np.concatenate([before.ravel(), np.zeros(3), np.full(3, 0.01), np.full(3, 0.02)])
+    expected = np.array([model.inverse_dynamics(*s) for s in zip(x, v, a, strict=True)])
+    np.testing.assert_allclose(W @ theta, expected.ravel(), atol=1e-12)
+    np.testing.assert_array_equal(body_parameters(model), before)
 
 
 def test_the_base_set_carries_every_standard_parameter() -> None:

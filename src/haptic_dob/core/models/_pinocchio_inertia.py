@@ -6,7 +6,8 @@ Its parameters are pinocchio's dynamic parameters ``m, m cx, m cy, m cz, Ixx, Ix
 Iyz, Izz`` (kg, kg m, kg m^2): the mass, its first moment and the rotational inertia about the
 joint frame's origin, in the joint frame's axes. The regressor ``Y(q, q', q'')`` (dof, 10 per
 body) gives the rigid-body effort ``Y theta`` (pinocchio's ``computeJointTorqueRegressor``), in
-our joint order; armature and friction are not in it.
+our joint order; armature and friction are not in it. With mimic joints (a parallelogram), which
+that function refuses, a body's columns are RNEA's differences: RNEA is linear in ``theta``.
 """
 
 from __future__ import annotations
@@ -44,10 +45,12 @@ class Body:
         return self.links[0][0]
 
 
+#: each body's parameters where the mimic regressor's differences start (a unit mass, no lever)
+_REFERENCE = np.array([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 1.0])
+
+
 def _checked(model: PinocchioModel) -> pin.Model:
-    """The pinocchio model; ``ValueError`` for mimic joints (their bodies are not separable)."""
-    if model._mimic:
-        raise ValueError("the inertial parameters of an arm with mimic joints are not identified")
+    """The pinocchio model."""
     m: pin.Model = model._model
     return m
 
@@ -85,9 +88,34 @@ def torque_regressor(model: PinocchioModel, q: Vec, qd: Vec, qdd: Vec) -> Mat:
     """``Y`` (dof, 10 per body) with ``Y theta`` the rigid-body effort at ``q, q', q''``."""
     m = _checked(model)
     d = model._data
-    Y = pin.computeJointTorqueRegressor(m, d, model._conf(q), model._vel(qd), model._vel(qdd))
+    qt, vt, at = model._conf(q), model._vel(qd), model._vel(qdd)
+    if model._mimic:
+        Y = _mimic_regressor(m, d, qt, vt, at)
+    else:
+        Y = pin.computeJointTorqueRegressor(m, d, qt, vt, at)
     out: Mat = Y.copy() if model._S is None else model._St @ Y
     return out
+
+
+def _mimic_regressor(m: pin.Model, d: pin.Data, q: Vec, qd: Vec, qdd: Vec) -> Mat:
+    """``Y`` by RNEA's differences (it is linear in each body's ten parameters): every body at
+    ``_REFERENCE``, one parameter up by one at a time; the model's inertias are put back."""
+    saved = [pin.Inertia(m.inertias[j]) for j in range(m.njoints)]
+    reference = pin.Inertia.FromDynamicParameters(_REFERENCE)
+    try:
+        for j in range(1, m.njoints):
+            m.inertias[j] = reference
+        base = pin.rnea(m, d, q, qd, qdd).copy()
+        Y = np.empty((m.nv, 10 * (m.njoints - 1)))
+        for j in range(1, m.njoints):
+            for i in range(10):
+                m.inertias[j] = pin.Inertia.FromDynamicParameters(_REFERENCE + np.eye(10)[i])
+                Y[:, 10 * (j - 1) + i] = pin.rnea(m, d, q, qd, qdd) - base
+            m.inertias[j] = reference
+    finally:
+        for j, inertia in enumerate(saved):
+            m.inertias[j] = inertia
+    return Y
 
 
 def parameters_of(mass: float, com: Vec, inertia_com: Mat) -> Vec:
