@@ -11,8 +11,6 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from rosbags.highlevel import AnyReader
-
 from haptic_dob.bag.errors import BagError
 from haptic_dob.teleop.graph import TO_SLAVE
 from haptic_msgs_py.wire import TYPESTORE
@@ -68,6 +66,9 @@ def corrupt(shown: str, exc: BaseException) -> BagError:
 @contextmanager
 def open_bag(path: str | Path) -> Iterator[Any]:
     """An open ``rosbags.highlevel.AnyReader`` of one bag; problems become ``BagError``."""
+    # lazy: rosbags.highlevel (ruamel.yaml, rosbag1: ~0.1 s) only once a bag is opened
+    from rosbags.highlevel import AnyReader
+
     shown = str(path)
     p = check_bag_path(Path(path), shown)
     reader = AnyReader([p], default_typestore=TYPESTORE)
