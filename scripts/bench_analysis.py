@@ -29,6 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
+from haptic_dob.bag.write import write_session_bag
+from haptic_dob.core.control import ControlMode, ImpedanceLaw
+from haptic_sim.slide.session import SessionConfig, run_session
+
 ROOT = Path(__file__).resolve().parents[1]
 ANALYZE = Path(sys.executable).parent / "haptic-analyze"
 BAGS = {"40s": 1, "1h": 90}  # name -> how many 40 s sessions back to back
@@ -37,10 +41,6 @@ DEFAULT_DIR = Path(tempfile.gettempdir()) / "haptic_dob_bench_bags"  # where the
 
 def make_bag(directory: Path, name: str, storage: str) -> Path:
     """Write the named bag (unless it is there already); return its path."""
-    from haptic_dob.bag.write import write_session_bag
-    from haptic_dob.core.control import ControlMode, ImpedanceLaw
-    from haptic_sim.slide.session import SessionConfig, run_session
-
     path = directory / f"{name}_{storage}"
     if (path / "metadata.yaml").exists():
         return path

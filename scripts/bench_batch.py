@@ -7,13 +7,16 @@ from __future__ import annotations
 
 import statistics
 import time
+import timeit
+
+from haptic_dob.core.models import SlideModel
+from haptic_dob.core.observers.disturbance import DisturbanceObserver
+from haptic_sim.slide.session import SessionConfig, run_session
+from haptic_sim.slide.stability import law_for
 
 
 def bench_batch_session(repeat: int) -> str:
     """A 40 s slide session at 1 kHz (default config, OL and DOB): real-time factor, cycle."""
-    from haptic_sim.slide.session import SessionConfig, run_session
-    from haptic_sim.slide.stability import law_for
-
     out = []
     for mode, kf in (("OL", 0.0), ("DOB", 1.0)):
         cfg = SessionConfig().replace(law=law_for(mode, kf))
@@ -32,11 +35,6 @@ def bench_batch_session(repeat: int) -> str:
 
 def bench_observer_update(repeat: int) -> str:
     """One slide observer update (validation, implicit update, clip): microseconds."""
-    import timeit
-
-    from haptic_dob.core.models import SlideModel
-    from haptic_dob.core.observers.disturbance import DisturbanceObserver
-
     obs = DisturbanceObserver(SlideModel(), 41.6, 1e-3, 4.0)
     q, qd, tau = (0.001,), (0.01,), (0.5,)
     obs.update(q, qd, tau)
@@ -49,9 +47,6 @@ def bench_observer_update(repeat: int) -> str:
 
 def batch_cycle_us(mode: str = "DOB", kf: float = 1.0, seconds: float = 10.0) -> float:
     """One batch slide session's time per cycle (µs): the maths of the loop with no transport."""
-    from haptic_sim.slide.session import SessionConfig, run_session
-    from haptic_sim.slide.stability import law_for
-
     cfg = SessionConfig().replace(law=law_for(mode, kf), loop__duration_s=seconds)
     t0 = time.perf_counter()
     run_session(cfg)

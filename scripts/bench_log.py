@@ -21,6 +21,7 @@ CALLS = 200
 
 def _measure(name: str) -> dict[str, Any]:
     """In the child: one logger's first call and its calls said and throttled away (s)."""
+    # lazy: the child loads what a device process has; benchmarks.py stays without rclpy
     import rclpy.logging
 
     import haptic_sim.nodes.device_node  # noqa: F401  # what a device process has loaded

@@ -25,6 +25,10 @@ from haptic_dob.core.models.base import DeviceModel
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from benchmarks import machine
+from haptic_dob.core.models import PhantomModel, UrdfModel
+from haptic_dob.core.observers.disturbance import DisturbanceObserver
+from haptic_sim.arm.device import SimulatedArm
+from haptic_sim.hand import HandParams
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -35,8 +39,6 @@ def _median_us(fn: Callable[[], object], repeat: int, number: int) -> tuple[floa
 
 
 def _observer(model: DeviceModel, q: tuple, qd: tuple, tau: tuple, repeat: int) -> str:
-    from haptic_dob.core.observers.disturbance import DisturbanceObserver
-
     obs = DisturbanceObserver(model, 2.0, 1e-3, 50.0)
     obs.update(q, qd, tau)
     n = 20_000
@@ -55,15 +57,11 @@ def _observer(model: DeviceModel, q: tuple, qd: tuple, tau: tuple, repeat: int) 
 
 def bench_phantom(repeat: int) -> str:
     """PHANToM 1.5 (appendix B) observer update, dynamics by pinocchio on the open tree."""
-    from haptic_dob.core.models import PhantomModel
-
     return _observer(PhantomModel(), (0.1, 0.2, 1.4), (0.01, 0.02, -0.03), (0.1, 0.2, 0.3), repeat)
 
 
 def bench_arm7(repeat: int) -> str:
     """7-DOF URDF arm observer update."""
-    from haptic_dob.core.models import UrdfModel
-
     model = UrdfModel(ROOT / "config" / "urdf" / "arm7.urdf", "tool")
     q = tuple(np.linspace(0.1, 0.7, 7).tolist())
     qd = tuple(np.linspace(-0.2, 0.2, 7).tolist())
@@ -73,10 +71,6 @@ def bench_arm7(repeat: int) -> str:
 
 def bench_phantom_sim(repeat: int) -> str:
     """One 1 kHz cycle of the simulated PHANToM (10 RK4 sub-steps), without and with a hand."""
-    from haptic_dob.core.models import PhantomModel
-    from haptic_sim.arm.device import SimulatedArm
-    from haptic_sim.hand import HandParams
-
     out = []
     for behaviour in ("none", "semi_random"):
         dev = SimulatedArm(PhantomModel(), hand=HandParams(behaviour=behaviour))

@@ -24,6 +24,7 @@ import time
 from typing import Any
 
 from haptic_dob.runtime.ros.dds_hop import hop_us, peer_node
+from haptic_msgs_py import wire
 
 #: role -> (topics it publishes, topics it waits for before answering)
 Roles = dict[str, tuple[list[str], list[str]]]
@@ -57,9 +58,9 @@ PATTERNS: dict[str, Roles] = {
 def _peer(pattern: str, role: str, cycles: int, domain: str, stop: Any, out: Any) -> None:
     """One process of ``pattern``; the device times ``cycles`` cycles and puts the median."""
     ctx, node, ex = peer_node(f"pattern_{role}", domain)
+    # lazy: only the peer processes load rclpy
     from std_msgs.msg import Header
 
-    from haptic_msgs_py import wire
     from haptic_msgs_py.ros.qos import ESTIMATOR_IN, LOOP, LOOP_IN, LOOP_IN_BEST_EFFORT
 
     data = wire.encode(wire.header("base_link"))

@@ -6,12 +6,15 @@ each loop is pinned to its CPU, as ``--pin`` places the nodes.
 
 from __future__ import annotations
 
+import multiprocessing
 import os
+import queue
 import statistics
 import time
 from typing import Any
 
 from bench_graph import GRAPH_ARGS
+from haptic_dob.runtime.cpu_latency import hold
 
 FLOOR_S = 20.0  # length of one timer-floor run (s), as the real-time graph runs
 FLOOR_BUDGET_S = 0.5e-3  # a tick woken later than this counts as lost (s)
@@ -53,11 +56,6 @@ def bench_timer_floor(repeat: int) -> str:
     needs about 0.4 ms of its 1 ms period, on both CPUs). Uses ``--rt-priority`` and
     ``--cpu-latency`` when given (one loop per CPU, pinned, as ``--pin`` places the nodes).
     """
-    import multiprocessing
-    import queue
-
-    from haptic_dob.runtime.cpu_latency import hold
-
     ctx = multiprocessing.get_context("spawn")
     prio, latency = _option("--rt-priority"), _option("--cpu-latency")
     if prio is not None:  # refused here with the reason, not in each loop's process

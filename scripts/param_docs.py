@@ -9,19 +9,20 @@ import argparse
 import sys
 from pathlib import Path
 
+from haptic_dob.nodes.bridge_node import bridge_node_specs
+from haptic_dob.nodes.channel_node import channel_node_specs
+from haptic_dob.nodes.controller_node import controller_node_specs
+from haptic_dob.nodes.environment_node import environment_node_specs
+from haptic_dob.nodes.observer_node import observer_node_specs
+from haptic_dob.nodes.recorder_node import recorder_specs
+from haptic_dob.nodes.slave_controller_node import slave_controller_node_specs
+from haptic_sim.nodes.device_node import device_node_specs
+
 OUT = Path(__file__).resolve().parents[1] / "docs" / "parameters.md"
 
 
 def tables() -> list[tuple[str, str, list]]:
     """(node, ros2 run name, specs) of every node."""
-    from haptic_dob.nodes.bridge_node import bridge_node_specs
-    from haptic_dob.nodes.channel_node import channel_node_specs
-    from haptic_dob.nodes.controller_node import controller_node_specs
-    from haptic_dob.nodes.environment_node import environment_node_specs
-    from haptic_dob.nodes.observer_node import observer_node_specs
-    from haptic_dob.nodes.slave_controller_node import slave_controller_node_specs
-    from haptic_sim.nodes.device_node import device_node_specs
-
     out = [
         ("device_node", "haptic_sim device_node", device_node_specs()),
         ("environment_node", "haptic_dob environment_node", environment_node_specs()),
@@ -34,12 +35,9 @@ def tables() -> list[tuple[str, str, list]]:
             slave_controller_node_specs(),
         ),
         ("bridge_node", "haptic_dob bridge_node", bridge_node_specs()),
+        ("recorder_node", "haptic_dob recorder_node", recorder_specs()),
     ]
-    try:
-        from haptic_dob.nodes.recorder_node import recorder_specs
-    except ImportError:
-        return out
-    return [*out, ("recorder_node", "haptic_dob recorder_node", recorder_specs())]
+    return out
 
 
 def _range(spec) -> str:

@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
@@ -84,8 +85,6 @@ def twist_stamped(frame_id: str = "") -> Any:
 
 def joint_state(names: Sequence[str], frame_id: str = "") -> Any:
     """A JointState for ``names`` with empty position, velocity and effort."""
-    import numpy as np
-
     empty = np.zeros(0)
     return JointState(
         header=header(frame_id), name=list(names), position=empty, velocity=empty, effort=empty
@@ -94,8 +93,6 @@ def joint_state(names: Sequence[str], frame_id: str = "") -> Any:
 
 def float64_multi_array(label: str, data: Sequence[float]) -> Any:
     """A Float64MultiArray with one labelled dimension."""
-    import numpy as np
-
     n = len(data)
     return Float64MultiArray(
         layout=MultiArrayLayout(

@@ -164,7 +164,7 @@ def _responses(
 ) -> tuple[float, float, float]:
     """(static push per m of reference offset, force std and position std per m of reference
     std) at one wall, for the linear model of hand, slide and an ideally rendered wall."""
-    from scipy import signal
+    from scipy import signal  # lazy: a device without a band starts without scipy.signal
 
     m, b = mass_kg + params.mass_kg, viscous + params.damping_n_s_per_m
     kh, bh, mh = params.stiffness_n_per_m, params.damping_n_s_per_m, params.mass_kg
@@ -225,7 +225,7 @@ def depth_reference(
 def _band_filter(params: HandParams, dt: float) -> np.ndarray:
     """The reference's band-pass (4th-order Butterworth) at sample period ``dt`` (s), followed by
     the 2nd-order Butterworth low-pass at ``rolloff_hz`` when it is set."""
-    from scipy import signal  # here: a device process without a band (push and hold) starts faster
+    from scipy import signal  # lazy: a device without a band starts without scipy.signal
 
     nyq = 0.5 / dt
     sos: np.ndarray = signal.butter(
@@ -301,7 +301,7 @@ class HandReference:
             ramp = np.ones(n)
         pos = ramp * p.offset_m if p.active else np.zeros(n)
         if self._sos is not None:
-            from scipy import signal
+            from scipy import signal  # lazy: loaded by _band_filter already
 
             noise, self._zi = signal.sosfilt(self._sos, self._rng.standard_normal(n), zi=self._zi)
             pos = pos + self._scale * ramp * noise
@@ -320,7 +320,7 @@ def _noise_gain(sos: np.ndarray, dt: float, low_hz: float) -> float:
     ``sigma^2 = 2 dt * integral_0^{fs/2} |H(f)|^2 df``, integrated on a log-spaced grid dense
     around the pass band.
     """
-    from scipy import signal
+    from scipy import signal  # lazy: a device without a band starts without scipy.signal
 
     fs = 1.0 / dt
     f = np.geomspace(low_hz * 1e-3, fs / 2.0, 200_000)

@@ -12,7 +12,7 @@ from haptic_dob.core.environment import VirtualWall
 from haptic_dob.core.excitation import Excitation
 from haptic_dob.core.models.slide import SlideParams
 from haptic_sim.hand import HandParams
-from haptic_sim.slide.device import SlideDeviceParams
+from haptic_sim.slide.plant import SlideDeviceParams
 from haptic_sim.slide.session import SessionConfig, run_session
 
 SPRING = VirtualWall(stiffness_n_per_m=80.0, two_sided=True)

@@ -16,7 +16,7 @@ import pytest
 
 from haptic_dob.bag.joints import read_joint
 from haptic_dob.runtime.params import load_node_params
-from haptic_sim.slide.device import SlideDeviceParams
+from haptic_sim.slide.plant import SlideDeviceParams
 from haptic_sim.slide.session import SessionConfig, run_session
 from support.paths import tool
 from support.rosgraph import isolated_env

@@ -96,7 +96,7 @@ def _window(
     segment_s: float,
 ) -> Oscillation | None:
     """The figures of one window (see the module docstring)."""
-    from scipy import signal  # on use: a node process that never analyses starts faster
+    from scipy import signal  # lazy: scipy.signal (~0.5 s) off a node's start-up
 
     lo, hi = s.band_hz
     hi = min(hi, 0.45 * fs_hz)

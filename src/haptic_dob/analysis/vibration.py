@@ -47,7 +47,7 @@ def envelope_growth(
         stop_amplitude: end the fit where the envelope first exceeds this (signal units).
         edge_s: time trimmed at each end against the Hilbert transform's edge effects (s).
     """
-    from scipy import signal  # on use: a node process that never analyses starts faster
+    from scipy import signal  # lazy: scipy.signal (~0.5 s) off a node's start-up
 
     fs = positive("fs_hz", fs_hz)
     xa = np.asarray(x, dtype=np.float64).reshape(-1)
@@ -106,7 +106,7 @@ def perturbation_response(
     0.2 s before the pulse means the contact itself started a sustained oscillation: the wall
     vibrates and its growth is not measured (NaN).
     """
-    from scipy import signal  # on use: a node process that never analyses starts faster
+    from scipy import signal  # lazy: scipy.signal (~0.5 s) off a node's start-up
 
     fs = positive("fs_hz", fs_hz)
     d = np.asarray(depth_m, dtype=np.float64).reshape(-1)

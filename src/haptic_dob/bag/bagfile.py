@@ -13,6 +13,7 @@ from typing import Any
 
 from haptic_dob.bag.errors import BagError
 from haptic_dob.teleop.graph import TO_SLAVE
+from haptic_msgs_py.wire import TYPESTORE
 
 _MCAP_MAGIC = b"\x89MCAP0\r\n"
 _SQLITE_MAGIC = b"SQLite format 3\x00"
@@ -65,9 +66,8 @@ def corrupt(shown: str, exc: BaseException) -> BagError:
 @contextmanager
 def open_bag(path: str | Path) -> Iterator[Any]:
     """An open ``rosbags.highlevel.AnyReader`` of one bag; problems become ``BagError``."""
+    # lazy: rosbags.highlevel (ruamel.yaml, rosbag1: ~0.1 s) only once a bag is opened
     from rosbags.highlevel import AnyReader
-
-    from haptic_msgs_py.wire import TYPESTORE
 
     shown = str(path)
     p = check_bag_path(Path(path), shown)

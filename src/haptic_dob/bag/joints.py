@@ -21,6 +21,7 @@ from haptic_dob.bag.bagfile import listing, open_bag, resolve_topic, topics_of
 from haptic_dob.bag.errors import BagError
 from haptic_dob.bag.series import JOINT_STATE
 from haptic_dob.identification.one_dof import JointRecord
+from haptic_msgs_py.wire import TYPESTORE
 
 
 @dataclass(frozen=True)
@@ -42,8 +43,6 @@ def read_joints(
     Messages that do not name every wanted joint (a topic that interleaves an arm's and a
     gripper's states) are left out; a driver that names no joints gives its joints in order.
     """
-    from haptic_msgs_py.wire import TYPESTORE
-
     shown = str(path)
     chosen = bool(joints)
     with open_bag(path) as reader:

@@ -46,7 +46,7 @@ def _stem(bag: str) -> str:
 
 def write_plots(analyses: list[BagAnalysis], directory: str | Path) -> list[Path]:
     """Write every segment's figures into ``directory`` (created); returns the files."""
-    import matplotlib
+    import matplotlib  # lazy: the Agg backend is chosen before pyplot loads
 
     matplotlib.use("Agg")
     out = Path(directory)
@@ -65,7 +65,7 @@ def write_plots(analyses: list[BagAnalysis], directory: str | Path) -> list[Path
 
 
 def _segment_plots(r: SegmentResult, prefix: Path) -> list[Path]:
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # lazy: after write_plots chose the Agg backend
 
     files = []
     title = f"{Path(r.bag).name} segment {r.segment.index}: {r.label}"
@@ -118,7 +118,7 @@ def _segment_plots(r: SegmentResult, prefix: Path) -> list[Path]:
 
 
 def _save(fig: Any, path: Path) -> Path:
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # lazy: after write_plots chose the Agg backend
 
     fig.tight_layout()
     fig.savefig(path, dpi=100)

@@ -26,6 +26,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from rosbags.rosbag2 import WriterError
+from rosbags.rosbag2.errors import ReaderError
+from rosbags.rosbag2.storage_mcap import McapReader
+from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
 from haptic_dob.bag.cdr import stamp_reader
 from haptic_dob.bag.errors import BagError
 from haptic_dob.bag.write import open_writer
@@ -186,11 +192,7 @@ def _copy_readable(path: Path, storage: str, work: Path) -> tuple[Path, int]:
 def _reader(copy: Path, storage: str) -> Any:
     """rosbags' storage-level reader of one file (no metadata.yaml needed)."""
     if storage == "mcap":
-        from rosbags.rosbag2.storage_mcap import McapReader
-
         return McapReader(copy)
-    from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader
-
     return Sqlite3Reader(copy)
 
 
@@ -205,8 +207,6 @@ def _in_file_order(reader: Any, conns: list[Any], storage: str) -> Any:
 
 def _typestore(conns: list[Any], path: Path) -> Any:
     """Jazzy's typestore, with any type of ``conns`` it lacks read from the bag's definition."""
-    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-
     typestore = get_typestore(Stores.ROS2_JAZZY)
     for c in conns:
         if c.msgtype not in typestore.fielddefs:
@@ -240,9 +240,6 @@ class _Span:
 def recover(bag: str | Path, out: str | Path | None = None) -> Recovery:
     """Write the complete part of the killed recording ``bag`` to a new bag ``out`` (default:
     ``<bag>_recovered``). Raises ``BagError`` (one line) when there is nothing to recover."""
-    from rosbags.rosbag2 import WriterError
-    from rosbags.rosbag2.errors import ReaderError
-
     bag = Path(bag)
     if (bag / "metadata.yaml").is_file():
         raise BagError(f"{bag} has its metadata.yaml: it was closed, there is nothing to recover")

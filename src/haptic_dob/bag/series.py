@@ -15,6 +15,7 @@ import numpy as np
 
 from haptic_dob.bag.cdr import decode_joint, decode_vectors
 from haptic_dob.bag.errors import BagError
+from haptic_msgs_py.wire import TYPESTORE
 
 POSE = "geometry_msgs/msg/PoseStamped"
 WRENCH = "geometry_msgs/msg/WrenchStamped"
@@ -133,7 +134,5 @@ def joint_decoder(joint: str | None, shown: str, topic: str) -> Decoder:
 
 
 def _joint_names(data: bytes) -> list[str]:
-    from haptic_msgs_py.wire import TYPESTORE
-
     msg: Any = TYPESTORE.deserialize_cdr(data, JOINT_STATE)
     return list(msg.name)

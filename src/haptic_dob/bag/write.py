@@ -16,10 +16,12 @@ import struct
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
+from rosbags.rosbag2 import StoragePlugin, Writer
 
+from haptic_dob.bag.jazzy import JazzyWriter
 from haptic_msgs_py import wire
 from haptic_msgs_py.stamps import NS_PER_S, period_ns
 from haptic_msgs_py.topics import (
@@ -35,9 +37,6 @@ from haptic_msgs_py.topics import (
     WRENCH_ESTIMATE,
     WRENCH_MEASURED,
 )
-
-if TYPE_CHECKING:
-    from rosbags.rosbag2 import Writer
 
 EPOCH_NS = 1_767_225_600 * NS_PER_S  # 2026-01-01: receive times of written bags start here
 _MARK = 1.0e-300  # marker values located in a template's bytes
@@ -215,10 +214,6 @@ def open_writer(path: str | Path, storage: str) -> Writer:
 
     Raises ``rosbags.rosbag2.WriterError`` or ``OSError`` when the bag cannot be created.
     """
-    from rosbags.rosbag2 import StoragePlugin
-
-    from haptic_dob.bag.jazzy import JazzyWriter  # rosbags' writer: loaded with it, when used
-
     plugin = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}[storage]
     writer = JazzyWriter(Path(path), version=9, storage_plugin=plugin)
     writer.open()

@@ -41,6 +41,7 @@ def command(
     plot_dir: str | None,
 ) -> int:
     """Analyse ``bags`` and print the chosen output; raises ``BagError``/``ValueError``."""
+    # lazy: --help and bad arguments answer before numpy, scipy and rosbags load
     from haptic_dob.analysis.oscillation import OscillationSettings
     from haptic_dob.bag.analyze import AnalysisSettings, analyze_bag
     from haptic_dob.bag.reader import Selection
@@ -71,7 +72,7 @@ def command(
     except BrokenPipeError:  # the reader went away (``| head``): not an error of ours
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     if plot_dir is not None:
-        from haptic_dob.bag.plots import write_plots
+        from haptic_dob.bag.plots import write_plots  # lazy: matplotlib only with --plot
 
         files = write_plots(analyses, plot_dir)
         print(f"wrote {len(files)} figure(s) to {plot_dir}", file=sys.stderr)

@@ -32,6 +32,7 @@ def _floats(text: str, n: int | None, name: str) -> list[float]:
 
 def command(a: argparse.Namespace, line: str) -> int:
     """Design, write (``line``, the command line, in the file), print; errors raise."""
+    # lazy: --help and bad arguments answer before pinocchio and scipy load
     from haptic_dob.core.models import UrdfModel
     from haptic_dob.identification.arm_excitation import ExcitationLimits
     from haptic_dob.identification.arm_excitation_design import design_excitation

@@ -16,18 +16,26 @@ load after the session's config.
 
 from __future__ import annotations
 
+import copy
 import json
 import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import yaml
+
+from haptic_dob.bag.joints import read_joint, read_joints
 from haptic_dob.cli.common import ArgumentParser, run
+from haptic_dob.core.models import UrdfModel
+from haptic_dob.core.models._pinocchio_urdf import read_urdf
 from haptic_dob.errors import InputError
-from haptic_dob.identification.arm_friction import ArmFrictionFit
+from haptic_dob.identification.arm_friction import ArmFrictionFit, identify_arm_friction
+from haptic_dob.identification.arm_model import Record, identify_arm_model
+from haptic_dob.identification.arm_model_report import table as model_table
 from haptic_dob.identification.filters import plus_minus
-from haptic_dob.identification.one_dof import METHODS, IdentificationError, SlideFit
-from haptic_dob.identification.per_axis import AxesFit
+from haptic_dob.identification.one_dof import METHODS, IdentificationError, SlideFit, identify
+from haptic_dob.identification.per_axis import AxesFit, identify_axes
 from haptic_dob.runtime.configs import config_dir
 
 
@@ -71,10 +79,6 @@ MODEL_NODES = ("observer_node", "controller_node")
 def model_yaml(params: Mapping[str, object], what: str, bag: str) -> str:
     """A params file that sets ``params`` of the observer's and the controller's model (each
     node its own copy of a list: YAML would alias a shared one, and rcl refuses aliases)."""
-    import copy
-
-    import yaml
-
     head = f"# identified from {bag} by haptic-identify ({what})\n"
     doc = {f"/**/{n}": {"ros__parameters": copy.deepcopy(dict(params))} for n in MODEL_NODES}
     body: str = yaml.safe_dump(doc, sort_keys=False)
@@ -110,10 +114,6 @@ def installed_urdf(name: str) -> str:
 
 def arm_command(bag: str, topic: str, arm: ArmSpec, as_json: bool, write_yaml: str | None) -> int:
     """Identify an arm's joint friction, print it, optionally write it as the model's."""
-    from haptic_dob.bag.joints import read_joints
-    from haptic_dob.core.models import UrdfModel
-    from haptic_dob.identification.arm_friction import identify_arm_friction
-
     urdf = installed_urdf(arm.urdf)
     rigid = UrdfModel(urdf, arm.tip_frame, arm.joints or None, viscous=0.0, coulomb=0.0)
     js = read_joints(bag, topic, rigid.joint_names)
@@ -144,12 +144,6 @@ def inertial_command(
     bag: str, topic: str, arm: ArmSpec, as_json: bool, write_urdf: str | None
 ) -> int:
     """Identify an arm's whole model, print it, optionally write it back as a URDF."""
-    from haptic_dob.bag.joints import read_joints
-    from haptic_dob.core.models import UrdfModel
-    from haptic_dob.core.models._pinocchio_urdf import read_urdf
-    from haptic_dob.identification.arm_model import Record, identify_arm_model
-    from haptic_dob.identification.arm_model_report import table as model_table
-
     urdf = installed_urdf(arm.urdf)
     cad = UrdfModel(urdf, arm.tip_frame, arm.joints or None)
     js = read_joints(bag, topic, cad.joint_names)
@@ -204,9 +198,6 @@ def axes_command(
     bag: str, topic: str, axes: tuple[str, ...], as_json: bool, write_yaml: str | None
 ) -> int:
     """Identify every axis of a Cartesian device, print, optionally write its point-mass model."""
-    from haptic_dob.bag.joints import read_joints
-    from haptic_dob.identification.per_axis import identify_axes
-
     js = read_joints(bag, topic, axes)
     try:
         fit = identify_axes(js.stamps_ns, js.position, js.effort, js.names)
@@ -228,9 +219,6 @@ def command(
     bag: str, topic: str, joint: str | None, method: str, as_json: bool, write_yaml: str | None
 ) -> int:
     """Identify, print, optionally write the model; errors raise (``run`` reports them)."""
-    from haptic_dob.bag.joints import read_joint
-    from haptic_dob.identification.one_dof import identify
-
     rec = read_joint(bag, topic, joint)
     try:
         fit = identify(rec, method)

@@ -40,7 +40,7 @@ def command(
         raise InputError(f"--rate must be > 0 Hz, got {rate_hz:g}")
     if namespace and not namespace.startswith("/"):
         namespace = "/" + namespace
-    from haptic_dob.nodes.recorder_run import record
+    from haptic_dob.nodes.recorder_run import record  # lazy: rclpy after the arguments are checked
 
     code, node = record(
         str(path), storage, namespace, duration, topics, node_name, rate_hz, log_time
@@ -106,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def recover_command(bag: str, output: str | None) -> int:
     """``--recover BAG``: the killed recording's complete records into a new bag."""
-    from haptic_dob.bag.recover import recover
+    from haptic_dob.bag.recover import recover  # lazy: --help answers before rosbags loads
 
     print(recover(bag, output).summary())
     return 0

@@ -16,7 +16,9 @@ import yaml
 from haptic_dob.core.command_authority import new_token
 from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import NODES
+from haptic_dob.runtime import cpus
 from haptic_dob.runtime.configs import urdf_beside
+from haptic_dob.runtime.cpu_latency import NO_REQUEST
 from haptic_dob.runtime.params import load_node_params
 
 
@@ -64,34 +66,29 @@ def add_pinning(params: dict[str, Any]) -> str:
     """``--pin``: each loop node's ``cpu_affinity`` from the critical-path placement
     (``haptic_dob.runtime.cpus``), unless the config (its node section or ``/**``) or ``--set`` gave
     one; returns the plan's text."""
-    from haptic_dob.runtime.cpus import available_cpus, describe, placement
-
     try:
-        assigned = placement([n for n in params if n != "/**"], available_cpus())
+        assigned = cpus.placement([n for n in params if n != "/**"], cpus.available_cpus())
     except ValueError as exc:
         raise InputError(f"--pin: {exc}") from None
     common = params.get("/**", {}).get("cpu_affinity")
-    for name, cpus in assigned.items():
+    for name, chosen in assigned.items():
         given = params[name].get("cpu_affinity", common)
         if given is not None and not isinstance(given, list):
             raise InputError(f"cpu_affinity of {name} must be a list of CPU numbers, got {given!r}")
         if given:
             assigned[name] = given
         else:
-            params[name]["cpu_affinity"] = cpus
-    return describe(assigned)
+            params[name]["cpu_affinity"] = chosen
+    return cpus.describe(assigned)
 
 
 def add_cpu_latency(params: dict[str, Any], latency_us: int) -> None:
     """``--cpu-latency``: each loop node's ``cpu_latency_us``, unless the config or ``--set``
     gave a request (its node section or ``/**``; -1, no request, counts as not given)."""
-    from haptic_dob.runtime.cpu_latency import NO_REQUEST
-    from haptic_dob.runtime.cpus import PAIRS
-
     if not 0 <= latency_us <= 1_000_000:
         raise InputError(f"--cpu-latency {latency_us}: must be 0 to 1000000 us (0: idle CPUs poll)")
     common = params.get("/**", {}).get("cpu_latency_us")
-    for name in (n for pair in PAIRS for n in pair if n in params):
+    for name in (n for pair in cpus.PAIRS for n in pair if n in params):
         if params[name].get("cpu_latency_us", common) in (None, NO_REQUEST):
             params[name]["cpu_latency_us"] = latency_us
 

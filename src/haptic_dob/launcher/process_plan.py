@@ -9,8 +9,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ament_index_python.packages import PackageNotFoundError, get_package_prefix
+
 from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import CONTAINER, LOOP_NODES, NODES, START_ORDER
+from haptic_msgs_py.ament import ensure_ament_prefix
 
 
 @dataclass
@@ -33,10 +36,6 @@ class ProcessSpec:
 
 def executable(package: str, name: str) -> str:
     """``<prefix>/lib/<package>/<name>`` from the ament index: what ``ros2 run`` executes."""
-    from ament_index_python.packages import PackageNotFoundError, get_package_prefix
-
-    from haptic_msgs_py.ament import ensure_ament_prefix
-
     ensure_ament_prefix()
     try:
         path = Path(get_package_prefix(package)) / "lib" / package / name

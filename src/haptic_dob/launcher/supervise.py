@@ -13,6 +13,7 @@ import time
 
 from haptic_dob.errors import InputError
 from haptic_dob.launcher.process_plan import ProcessSpec
+from haptic_dob.runtime.cpu_latency import hold
 
 RT_PRIORITIES = range(1, 100)  # SCHED_FIFO priorities Linux accepts
 
@@ -38,8 +39,6 @@ def set_rt_priority(priority: int) -> None:
 def check_cpu_latency_request(latency_us: int) -> None:
     """Make the request once and withdraw it: a launch that cannot make it stops before any
     node starts, with the reason (``InputError``)."""
-    from haptic_dob.runtime.cpu_latency import hold
-
     try:
         os.close(hold(latency_us))
     except ValueError as exc:

@@ -5,6 +5,9 @@ The parameter groups the loop nodes share are ``haptic_dob.nodes.settings``.
 
 from __future__ import annotations
 
+import os
+import sys
+import textwrap
 from collections.abc import Iterable
 
 from haptic_dob.runtime.params import ParamSpec
@@ -12,9 +15,6 @@ from haptic_dob.runtime.params import ParamSpec
 
 def usage(node_class: type, specs: list[ParamSpec]) -> str:
     """``--help`` of a node executable: how to run it, what it does, its parameters."""
-    import sys
-    import textwrap
-
     module = sys.modules[node_class.__module__]
     doc = (module.__doc__ or "").strip().split("\n\n")[0]
     spec = getattr(module, "__spec__", None)  # ``python -m``: the module is __main__
@@ -62,9 +62,6 @@ def own_args(argv: list[str]) -> list[str]:
 def main_for(node_class: type, args: list[str] | None, specs: list[ParamSpec]) -> int:
     """``main()`` of a single-node executable: spin it until Ctrl-C/SIGTERM. ``--help`` prints
     ``usage`` with ``specs``; any other argument before ``--ros-args`` is refused (exit 2)."""
-    import os
-    import sys
-
     argv = list(sys.argv if args is None else args)
     own = own_args(argv)
     if own[:1] in (["-h"], ["--help"]):
@@ -80,6 +77,7 @@ def main_for(node_class: type, args: list[str] | None, specs: list[ParamSpec]) -
             file=sys.stderr,
         )
         return 2
+    # lazy: usage and missing_nodes stay rclpy-free (unit tests, --help)
     from haptic_dob.runtime.ros.spin import run_nodes
     from haptic_msgs_py.ament import ensure_ament_prefix
 

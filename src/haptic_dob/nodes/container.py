@@ -15,7 +15,9 @@ from __future__ import annotations
 import sys
 
 from haptic_dob.nodes.registry import NODES, START_ORDER, node_class
+from haptic_dob.runtime.ros.spin import run_nodes
 from haptic_dob.runtime.ros_args import configured_nodes
+from haptic_msgs_py.ament import ensure_ament_prefix
 
 USAGE = (
     "usage: container [NODE ...] [--ros-args [--params-file FILE] ...]\n"
@@ -63,9 +65,6 @@ def main(args: list[str] | None = None) -> int:
     except ValueError as exc:
         print(f"ERROR: {exc}", file=sys.stderr)
         return 2
-    from haptic_dob.runtime.ros.spin import run_nodes
-    from haptic_msgs_py.ament import ensure_ament_prefix
-
     ensure_ament_prefix()
     return run_nodes(
         lambda ctx: [cls(context=ctx, name=name, namespace=ns) for ns, name, cls in classes],

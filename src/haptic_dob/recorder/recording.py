@@ -22,6 +22,8 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rosbags.rosbag2 import WriterError
+
 from haptic_dob.bag.cdr import stamp_reader
 from haptic_dob.bag.write import make_durable, open_writer, parameter_event
 from haptic_dob.recorder.counts import RecordingCounts
@@ -73,8 +75,6 @@ class Recording:
         log_time: str = "session",
         offered: OfferedQos = no_offers,
     ) -> None:
-        from rosbags.rosbag2 import WriterError
-
         if log_time not in LOG_TIMES:
             raise ValueError(f"log_time must be one of {', '.join(LOG_TIMES)}, got {log_time!r}")
         try:

@@ -7,15 +7,14 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
+
 from haptic_dob.errors import InputError
+from haptic_msgs_py.ament import ensure_ament_prefix
 
 
 def config_dir() -> Path:
     """The installed config directory (``<prefix>/share/haptic_dob/config``)."""
-    from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
-
-    from haptic_msgs_py.ament import ensure_ament_prefix
-
     ensure_ament_prefix()
     try:
         return Path(get_package_share_directory("haptic_dob")) / "config"

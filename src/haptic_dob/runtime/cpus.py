@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import time
 from collections.abc import Iterable, Mapping, Sequence
 
 #: the loop's nodes sharing one CPU when only two are available (the critical-path pairs)
@@ -103,8 +104,6 @@ def _cpu_times() -> tuple[float, float] | None:
 def free_cpus(sample_s: float = 0.5) -> float:
     """How many of this process's CPUs are idle now: the machine's idle share over ``sample_s``
     seconds times the CPUs this process may use (their count where the system cannot say)."""
-    import time
-
     usable = len(available_cpus())
     before = _cpu_times()
     if before is None:

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Any, TypeVar
 
+import yaml
+
 ParamValue = bool | int | float | str | list[float] | list[str]
 
 T = TypeVar("T")
@@ -265,8 +267,6 @@ def load_sections(path: Any) -> dict[str, dict[str, Any]]:
     Raises ``ValueError`` (one line) when the file is not such a file; ``OSError`` when it cannot
     be read.
     """
-    import yaml
-
     with open(path, encoding="utf-8") as fh:
         text = fh.read()
     try:

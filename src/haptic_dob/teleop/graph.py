@@ -16,6 +16,10 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from haptic_dob.runtime.configs import urdf_beside
+from haptic_dob.runtime.params import load_sections
+from haptic_msgs_py.topics import PARAMETER_EVENTS, POSE_DESIRED, SESSION_TOPICS, WRENCH_DESIRED
+
 NAMESPACES = ("master", "slave")
 #: the nodes of each side, in start order (the device last)
 SIDE_NODES = {
@@ -38,13 +42,6 @@ def recorded_topics() -> list[str]:
     topic of both sides (but the slave's ``wrench_desired``: it has no wall), the slave's
     ``pose_desired``, the channel's link both ways and the parameter events (each node's
     parameters)."""
-    from haptic_msgs_py.topics import (
-        PARAMETER_EVENTS,
-        POSE_DESIRED,
-        SESSION_TOPICS,
-        WRENCH_DESIRED,
-    )
-
     out = [
         f"/{ns}/{topic}:{kind}"
         for ns in NAMESPACES
@@ -67,9 +64,6 @@ def node_values(sections: Mapping[str, Mapping[str, Any]], ns: str, node: str) -
 def load_teleop_sections(path: str | Path) -> dict[str, dict[str, Any]]:
     """The YAML's sections, a relative ``urdf_path`` or ``slave.trajectory_path`` taken from the
     YAML's own directory (the installed ``teleop_sim.yaml`` names ``urdf/arm7.urdf`` beside it)."""
-    from haptic_dob.runtime.configs import urdf_beside
-    from haptic_dob.runtime.params import load_sections
-
     sections = load_sections(path)
     urdf_beside(sections, path)
     here = Path(path).resolve().parent

@@ -139,7 +139,7 @@ RUN_OPTIONS = {
 
 def bag_command(args: Any) -> int:
     """``--bag``: the figures (and ``--out``: the force-tracking figure) of a recorded graph."""
-    from haptic_sim.teleop.bag import read_teleop_bag
+    from haptic_sim.teleop.bag import read_teleop_bag  # lazy: rosbags only for --bag
 
     given = [flag for name, flag in RUN_OPTIONS.items() if getattr(args, name) not in (None, [])]
     if given:
@@ -165,6 +165,7 @@ def report(
 ) -> int:
     """Print the figures (and the sweep's); write the force-tracking figure of ``result``."""
     if out is not None and result is not None:
+        # lazy: the figures' modules (matplotlib, the report's) only with --out
         from haptic_sim.teleop.figures import plot_force_tracking
 
         out.mkdir(parents=True, exist_ok=True)
@@ -209,6 +210,7 @@ def command(args: Any) -> int:
     if delays is not None:
         points = delay_sweep(cfg, delays, protocol, workers=max(1, args.workers))
         if out is not None:
+            # lazy: the figures' modules (matplotlib, the report's) only with --out
             from haptic_sim.teleop.figures import plot_delay_sweep
 
             plot_delay_sweep(points, protocol.threshold_mm, out / "stability.png")

@@ -24,7 +24,8 @@ from haptic_sim.arm.device import ArmDeviceParams, SimulatedArm
 from haptic_sim.hand import HandParams
 from haptic_sim.point_mass.device import PointMassDeviceParams, SimulatedPointMass
 from haptic_sim.sensor import ForceSensorParams
-from haptic_sim.slide.device import SimulatedSlide, SlideDeviceParams
+from haptic_sim.slide.device import SimulatedSlide
+from haptic_sim.slide.plant import SlideDeviceParams
 from haptic_sim.slide.session import LoopSettings
 
 #: an arm touches nothing unless ``contact.stiffness_n_per_m`` says so

@@ -1,17 +1,20 @@
 """The simulated device's cycle, ROS-free: when sample k goes out and which command moves the plant.
 
-- lockstep: sample 0 goes out once the graph is up (``LoopPort.waiting_for``) and settled; sample
-  k+1 only after command k came (labelled with sample k's stamp, or unlabelled); without it for
-  ``lockstep_timeout_s`` the loop says so and sends sample k again. While a recorder lags
-  (``RecorderGate``) command k is held; the run ends once the recorder wrote the last sample.
-- realtime: ticks on the wall clock's grid (sample 0's time plus whole periods) once the graph is
-  up, applies the newest valid command, steps the plant one period and stamps the sample with the
-  system clock. A tick a period or more late is an overrun and the grid points it passed are
-  missed ticks, lost (docs/running.md, "Clock modes"): a run of ``last_k`` periods ends
-  ``last_k`` periods after sample 0. ``CommandWatchdog`` counts the samples sent and zeroes the
-  effort when commands stop; ``RealtimeStats`` counts commands before the next tick, and overruns.
+Sample 0 goes out once the graph is up and settled (``StartGate``). Then:
 
-Every command passes the ``CommandGuard`` first; ``LoopPort``, the node, does what the loop says.
+- lockstep: sample k+1 only after command k came (labelled with sample k's stamp, or
+  unlabelled); without it for ``lockstep_timeout_s`` the loop says so and sends sample k again.
+  While a recorder lags (``RecorderGate``) command k is held; the run ends once the recorder
+  wrote the last sample.
+- realtime: ticks on the wall clock's grid (sample 0's time plus whole periods), applies the
+  newest valid command, steps the plant one period and stamps the sample with the system clock.
+  A tick a period or more late is an overrun and the grid points it passed are missed ticks,
+  lost (docs/running.md, "Clock modes"): a run of ``last_k`` periods ends ``last_k`` periods
+  after sample 0. ``CommandWatchdog`` counts the samples sent and zeroes the effort when
+  commands stop; ``RealtimeStats`` counts commands before the next tick, and overruns.
+
+Every command passes the ``CommandGuard`` first; ``CommandNews`` says what the loop has to say
+of the commands; ``LoopPort``, the node, does what the loop says.
 """
 
 from __future__ import annotations
@@ -19,51 +22,22 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable, Mapping
-from typing import Any, Protocol
+from typing import Any
 
 from haptic_dob.core.command_guard import CommandGuard
 from haptic_dob.core.watchdog import CommandWatchdog
 from haptic_msgs_py.topics import EFFORT_COMMAND
 from haptic_msgs_py.values import EffortCommand
+from haptic_sim.device.command_news import CommandNews
 from haptic_sim.device.cycle_stats import CycleStats, RealtimeStats
 from haptic_sim.device.factory import SimulatedDeviceKind
+from haptic_sim.device.port import Log, LoopPort
 from haptic_sim.device.recorder_gate import Drain, RecorderGate
 from haptic_sim.device.sample import DeviceSample
 from haptic_sim.device.settings import DeviceLoopSettings
+from haptic_sim.device.start_gate import GRAPH_POLL_S, StartGate
 
 STARTUP_RESEND_S = 0.5  # lockstep: sample 0 again this often until command 0 comes
-GRAPH_POLL_S = 0.05  # how often the start and the end of a run look at the graph again
-WATCHDOG_SAY_EVERY_S = 1.0  # the watchdog says at most a line this often; news waits, never lost
-
-
-class LoopPort(Protocol):
-    """What the loop needs from its node: the topics, deferred work and the ROS graph."""
-
-    def publish(self, sample: DeviceSample) -> None:
-        """Send sample k to every topic."""
-
-    def call_soon(self, work: Callable[[], None]) -> None:
-        """Run ``work`` once the publishes under way have returned (at once when none is)."""
-
-    def waiting_for(self) -> str:
-        """What the start still waits for in the graph ('' when nothing)."""
-
-    def recorders(self) -> int:
-        """How many recorders report their progress."""
-
-    def cycled(self) -> None:
-        """One cycle ran (for the loop rate in the diagnostics)."""
-
-    def finish(self) -> None:
-        """The run is over: the node may stop."""
-
-
-class Log(Protocol):
-    """Where the loop says what it does (a ROS logger: ``throttle_duration_sec`` and so on)."""
-
-    def info(self, message: str, **kwargs: Any) -> Any: ...
-
-    def warning(self, message: str, **kwargs: Any) -> Any: ...
 
 
 class DeviceLoop:
@@ -97,18 +71,17 @@ class DeviceLoop:
         self.lockstep = lockstep
         self.last_k = last_k
         self.period_ns = device.period_ns
-        self.guard = CommandGuard(device.max_effort, self._say_refusing)
+        self.news = CommandNews(log, device.dof)
+        self.guard = CommandGuard(device.max_effort, self.news.refusing)
         self.configure(self.settings_for(values))
-        self.watchdog = CommandWatchdog(self.period_ns, self._say_tripped, self._say_resumed)
-        self._news: tuple[bool, str] | None = None  # the watchdog's unsaid line (warning?, text)
-        self._say_after = -float("inf")  # monotonic s before which the watchdog says nothing
+        self.watchdog = CommandWatchdog(self.period_ns, self._tripped, self._resumed)
         self.realtime = RealtimeStats()
         self.recorders = RecorderGate()
+        self.start_gate = StartGate(port, self.recorders, log)  # when sample 0 goes out
         self.zero = [0.0] * device.dof
         self.latest = self.zero  # realtime: the newest valid command
         self.started = False
         self.stepped = False  # lockstep: command k applied, sample k+1 not yet published
-        self.ready_since: float | None = None  # monotonic s the graph was first up
         self.t_first = 0.0  # monotonic s of sample 0
         self.grid = 0  # real time: the wall-clock period of the newest tick since sample 0
         self.ticks = 0  # real time: samples sent after sample 0 (the watchdog's count)
@@ -126,40 +99,12 @@ class DeviceLoop:
         self.settings = settings
         self.guard.limits = settings.effort_limits
 
-    # --- what the loop says -------------------------------------------------------------------
-    def _say_refusing(self, effort: tuple[float, ...]) -> None:
-        self.log.warning(
-            f"refusing effort_command {list(effort)!r}: need {self.device.dof} finite values; "
-            "zero effort until a valid command"
-        )
+    # --- the watchdog's news (said once the tick's sample is out) -------------------------
+    def _tripped(self, held: str) -> None:
+        self.news.tripped(held, self.settings.command_timeout_s, self.watchdog.trips)
 
-    def _say_tripped(self, held: str) -> None:
-        """A trip, said once the tick's sample is out (``_say_pending``)."""
-        timeout = self.settings.command_timeout_s
-        self._news = (
-            True,
-            f"watchdog: no valid {EFFORT_COMMAND} for {held} (limit {timeout * 1e3:g} ms of "
-            f"samples sent): effort zeroed ({self.watchdog.trips} trips so far)",
-        )
-
-    def _say_resumed(self) -> None:
-        """The end of a trip, said after the next tick's sample; a trip not said yet is said
-        with it."""
-        resumed = "valid effort_command again: effort resumed"
-        if self._news is not None and self._news[0]:
-            self._news = (True, f"{self._news[1]}; {resumed}")
-        else:
-            self._news = (False, f"{resumed} (after trip {self.watchdog.trips})")
-
-    def _say_pending(self, now: float) -> None:
-        """Say the watchdog's newest news, at most one line every ``WATCHDOG_SAY_EVERY_S``: a
-        controller that comes and goes does not flood the log, and a trip soon after another
-        (a start-up trip, then a lost link) is said late rather than not at all."""
-        if self._news is not None and now >= self._say_after:
-            warning, line = self._news
-            (self.log.warning if warning else self.log.info)(line)
-            self._news = None
-            self._say_after = now + WATCHDOG_SAY_EVERY_S
+    def _resumed(self) -> None:
+        self.news.resumed(self.watchdog.trips)
 
     # --- inputs ---------------------------------------------------------------------------
     def command(self, cmd: EffortCommand) -> None:
@@ -239,14 +184,10 @@ class DeviceLoop:
             wall = time.monotonic() - self.t_first
             sim = s.k * self.period_ns * 1e-9
             rt = self.realtime
-            missed = (
-                ""
-                if self.lockstep
-                else f"; {rt.missed_ticks} ticks missed in {rt.overruns} overruns"
-            )
+            missed = f"; {rt.missed_ticks} ticks missed in {rt.overruns} overruns"
             self.log.info(
                 f"finished: {s.k} cycles ({sim:g} s simulated) in {wall:.2f} s, "
-                f"real-time factor {sim / wall:.2f}{missed}"
+                f"real-time factor {sim / wall:.2f}{'' if self.lockstep else missed}"
             )
             # stay up (publishers alive) until a recorder has written the last sample
             self.deadline = time.monotonic()
@@ -271,16 +212,11 @@ class DeviceLoop:
             self.deadline = now + GRAPH_POLL_S
             return
         if not self.started:
-            settling = self.ready_since is not None
-            if not self.graph_ready():  # again after the settle time: entities that came late
-                self.ready_since = None
-                self.deadline = now + GRAPH_POLL_S
+            settle = self.lockstep or bool(self.settings.wait_for)
+            look_again = self.start_gate.wait(now, self.settings, settle)
+            if look_again is not None:
+                self.deadline = look_again
                 return
-            if not settling:
-                self.ready_since = now
-                if self.lockstep or self.settings.wait_for:
-                    self.deadline = now + self.settings.start_delay_s
-                    return
         if not self.lockstep:
             self.tick(now)
         elif not self.started:
@@ -290,22 +226,6 @@ class DeviceLoop:
             self.deadline = now + STARTUP_RESEND_S
         else:
             self.lockstep_timeout(now)
-
-    def graph_ready(self) -> bool:
-        """Every ``wait_for`` node is up, known subscribers matched, a command publisher seen,
-        every recorder's readers matched.
-
-        While not, says what it waits for (every 5 s), so a device that does not start says why.
-        """
-        waiting = self.port.waiting_for()
-        if not waiting and self.recorders.unmatched(self.port.recorders()):
-            waiting = "the recorders' readers to match the loop's topics"
-        if waiting:
-            self.log.info(
-                f"waiting before sample 0 for {waiting} (wait_for: {list(self.settings.wait_for)})",
-                throttle_duration_sec=5.0,
-            )
-        return not waiting
 
     def lockstep_timeout(self, now: float) -> None:
         """Lockstep, no command moved the plant in time: hold for the recorder, or send again."""
@@ -360,16 +280,14 @@ class DeviceLoop:
         self.grid = grid
         self.ticks += 1
         self.send_sample()
-        self._say_pending(now)
+        self.news.say(now)
         self.deadline = self.t_first + (grid + 1) * period
 
     # --- end ------------------------------------------------------------------------------
     def stats(self) -> CycleStats:
         """Real-time cycle statistics so far."""
-        guard = self.guard
-        return self.realtime.result(
-            self.device.k, guard.refused, guard.limited, self.watchdog.trips
-        )
+        g = self.guard
+        return self.realtime.result(self.device.k, g.refused, g.limited, self.watchdog.trips)
 
     def shutdown(self) -> None:
         """Zero effort first; in real time one last period runs and is reported with it."""
@@ -377,4 +295,4 @@ class DeviceLoop:
         if not self.lockstep and self.started:
             self.advance(self.zero)
             self.send_sample()
-        self._say_pending(float("inf"))  # the watchdog's last news, however soon after a line
+        self.news.say(float("inf"))  # the watchdog's last news, however soon after a line

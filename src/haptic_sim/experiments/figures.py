@@ -20,10 +20,11 @@ from haptic_sim.slide.stability import detection_threshold_m
 
 def pyplot() -> Any:
     """matplotlib.pyplot on the Agg backend."""
+    # lazy: matplotlib only for a run that draws; Agg chosen before pyplot loads
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # lazy: after the backend is chosen
 
     return plt
 

@@ -30,7 +30,7 @@ from haptic_dob.runtime.params import values_of
 from haptic_sim.experiments.graph_runs import GraphRun, session_params
 from haptic_sim.experiments.records import Cell, Check, RunAnalysis
 from haptic_sim.hand import HandParams
-from haptic_sim.slide.device import SlideDeviceParams
+from haptic_sim.slide.plant import SlideDeviceParams
 from haptic_sim.slide.session import SessionConfig, run_session
 
 SPRING_N_PER_M = 80.0

@@ -9,6 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from haptic_sim.phantom.reproduction import KF_VALUES, reproduce_free_motion, reproduce_wall
+
 
 @dataclass(frozen=True)
 class PhantomWallCell:
@@ -31,8 +33,6 @@ class PhantomResult:
 
 def reproduce(figures: Path) -> PhantomResult:
     """Run 5.2.1 and 5.2.2 (their figures go to ``figures``)."""
-    from haptic_sim.phantom.reproduction import KF_VALUES, reproduce_free_motion, reproduce_wall
-
     free = reproduce_free_motion(figures)
     wall = reproduce_wall(figures)
     cells = []

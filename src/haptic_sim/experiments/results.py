@@ -17,6 +17,8 @@ from pathlib import Path
 from typing import Any
 
 from haptic_dob.analysis.linear_loop import linear_onset
+from haptic_dob.bag.analyze import analyze_bag
+from haptic_dob.bag.report import as_json
 from haptic_sim.experiments import thesis
 from haptic_sim.experiments.graph_runs import GraphRun, bag_path, run_dir
 from haptic_sim.experiments.plan import CH6_PARTS, CH7_CONTROLLERS, CH7_WALLS
@@ -46,9 +48,6 @@ def analyse_run(root: Path, run: GraphRun) -> RunAnalysis:
     if out.is_file() and out.stat().st_mtime >= bag.stat().st_mtime:
         segments: list[dict[str, Any]] = json.loads(out.read_text(encoding="utf-8"))
     else:
-        from haptic_dob.bag.analyze import analyze_bag
-        from haptic_dob.bag.report import as_json
-
         text = as_json([analyze_bag(bag)])
         out.write_text(text + "\n", encoding="utf-8")
         segments = json.loads(text)

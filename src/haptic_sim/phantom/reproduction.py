@@ -166,7 +166,7 @@ def wall_metrics(
 
 # --- figures ----------------------------------------------------------------------------------
 def _figure(width: float = 8.0, height: float = 5.0) -> Any:
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # lazy: the sessions alone run without matplotlib
 
     return Figure(figsize=(width, height), dpi=100)
 

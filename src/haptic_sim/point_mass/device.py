@@ -28,7 +28,8 @@ from haptic_sim.device.sample import DeviceSample
 from haptic_sim.hand import HandParams
 from haptic_sim.hand_space import CartesianReference, hand_references
 from haptic_sim.sensor import ForceSensorParams
-from haptic_sim.slide.device import SimulatedSlide, SlideDeviceParams
+from haptic_sim.slide.device import SimulatedSlide
+from haptic_sim.slide.plant import SlideDeviceParams
 
 #: the Force Dimension SDK's force cap with gravity compensation on (N per axis)
 FD_MAX_FORCE_N = 12.0

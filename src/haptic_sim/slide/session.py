@@ -29,7 +29,8 @@ from haptic_dob.core.validation import nonnegative, positive
 from haptic_dob.runtime.params import build, load_node_params, node_view, param, replace_groups
 from haptic_sim.hand import HandParams
 from haptic_sim.sensor import ForceSensorParams
-from haptic_sim.slide.device import SimulatedSlide, SlideDeviceParams
+from haptic_sim.slide.device import SimulatedSlide
+from haptic_sim.slide.plant import SlideDeviceParams
 
 
 @dataclass(frozen=True)

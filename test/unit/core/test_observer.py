@@ -11,7 +11,8 @@ from haptic_dob.core.models import DeviceModel, SlideModel, SlideParams
 from haptic_dob.core.observers.disturbance import DisturbanceObserver
 from haptic_dob.core.tip_force import dls_transpose_solve
 from haptic_sim.hand import HandParams
-from haptic_sim.slide.device import SimulatedSlide, SlideDeviceParams
+from haptic_sim.slide.device import SimulatedSlide
+from haptic_sim.slide.plant import SlideDeviceParams
 
 
 def constant_force_run(gain: float, force_n: float = 1.0, t_on: float = 0.1, drive=None):

@@ -137,7 +137,7 @@ def test_chapter_4_checks_hold_least_squares_and_the_step_method_to_their_bounds
 
     from haptic_dob.identification.one_dof import SlideFit
     from haptic_sim.experiments.identification import ch4_checks
-    from haptic_sim.slide.device import SlideDeviceParams
+    from haptic_sim.slide.plant import SlideDeviceParams
 
     truth = SlideDeviceParams()  # m 0.416, c 1.272, Fc 0.24
 

@@ -23,6 +23,7 @@ THESIS = "haptic_sim.experiments.thesis"
 CHOOSERS = (
     "haptic_sim.hand",
     "haptic_sim.slide.device",
+    "haptic_sim.slide.plant",
     "haptic_sim.slide.session",
     "haptic_sim.slide.stability",
     "haptic_sim.experiments.observer_gain",

@@ -21,7 +21,8 @@ from haptic_dob.core.models.slide import SlideParams
 from haptic_dob.identification.one_dof import IdentificationError, JointRecord, identify
 from haptic_dob.runtime.params import load_node_params
 from haptic_sim.hand import HandParams
-from haptic_sim.slide.device import SimulatedSlide, SlideDeviceParams
+from haptic_sim.slide.device import SimulatedSlide
+from haptic_sim.slide.plant import SlideDeviceParams
 from support.joint_bags import write_bag
 
 TRUTH = SlideParams()  # m 0.416 kg, c 1.272 N s/m, Fc 0.24 N

@@ -8,7 +8,8 @@ import pytest
 
 from haptic_dob.core.models.slide import SlideParams
 from haptic_sim.hand import HandParams
-from haptic_sim.slide.device import SimulatedSlide, SlideDeviceParams
+from haptic_sim.slide.device import SimulatedSlide
+from haptic_sim.slide.plant import SlideDeviceParams
 
 NO_HAND = HandParams(behaviour="none")
 

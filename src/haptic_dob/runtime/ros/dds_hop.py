@@ -16,6 +16,8 @@ import statistics
 import time
 from typing import Any
 
+from haptic_msgs_py import wire
+
 WARM_UP = 0.1  # share of the round trips left out at the start
 
 
@@ -23,6 +25,7 @@ def peer_node(name: str, domain: str) -> tuple[Any, Any, Any]:
     """(context, node, events executor) of a benchmark process on ``domain``, localhost only."""
     os.environ["ROS_DOMAIN_ID"] = domain
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    # lazy: only the peer processes load rclpy, their callers stay ROS-free
     import rclpy
     from rclpy.context import Context
     from rclpy.experimental.events_executor import EventsExecutor
@@ -37,9 +40,9 @@ def _hop_peer(role: str, n: int, domain: str, out: Any) -> None:
     executor, the loop's QoS: reliable volatile publisher, best-effort subscription as the
     sensor streams take it)."""
     ctx, node, ex = peer_node(f"hop_{role}", domain)
+    # lazy: only the peer processes load rclpy
     from std_msgs.msg import Header
 
-    from haptic_msgs_py import wire
     from haptic_msgs_py.ros.qos import LOOP, LOOP_IN_BEST_EFFORT
 
     send, receive = ("ping", "pong") if role == "a" else ("pong", "ping")

@@ -17,6 +17,7 @@ teleoperation graph's master and slave composed both finish their runs.
 
 from __future__ import annotations
 
+import cProfile
 import gc
 import os
 import signal
@@ -28,8 +29,10 @@ from typing import Any
 import rclpy
 from rclpy._rclpy_pybind11 import RCLError, UnknownROSArgsError
 from rclpy.context import Context
+from rclpy.duration import Duration
 from rclpy.exceptions import InvalidParameterValueException, ParameterException
 from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.experimental.events_executor import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
@@ -182,8 +185,6 @@ def run_over(nodes: Sequence[LoopNode]) -> bool:
 def make_executor(kind: str, context: Context) -> Executor:
     """``events`` (rclpy.experimental.EventsExecutor, the default) or ``single``."""
     if kind == "events":
-        from rclpy.experimental.events_executor import EventsExecutor
-
         return EventsExecutor(context=context)
     if kind == "single":
         return SingleThreadedExecutor(context=context)
@@ -254,8 +255,6 @@ def run_nodes(
         gc.set_threshold(50_000, 20, 20)  # ... and run it rarely: the loop makes few cycles
         profile_dir = os.environ.get("HAPTIC_DOB_PROFILE")
         if profile_dir:  # developer aid: per-process cProfile of the spin loop
-            import cProfile
-
             prof = cProfile.Profile()
             prof.enable()
         spin_once = ex.spin_once
@@ -346,8 +345,6 @@ def work_off(
 
 def wait_for_acknowledgements(nodes: Sequence[Node], until: float) -> bool:
     """Wait until every reliable reader acknowledged what ``nodes`` published (or ``until``)."""
-    from rclpy.duration import Duration
-
     for node in nodes:
         for pub in node.publishers:
             left = until - time.monotonic()
