@@ -3,19 +3,15 @@
 Sample 0 goes out once the graph is up and settled (``StartGate``). Then:
 
 - lockstep: sample k+1 only after command k came (labelled with sample k's stamp, or
-  unlabelled); without it for ``lockstep_timeout_s`` the loop says so and sends sample k again.
-  While a recorder lags (``RecorderGate``) command k is held; the run ends once the recorder
-  wrote the last sample.
+  unlabelled); without it for ``lockstep_timeout_s`` the loop sends sample k again. While a
+  recorder lags (``RecorderGate``) command k is held.
 - realtime: ticks on the wall clock's grid (sample 0's time plus whole periods), applies the
-  newest valid command, steps the plant one period and stamps the sample with the system clock.
-  A tick a period or more late is an overrun and the grid points it passed are missed ticks,
-  lost (docs/running.md, "Clock modes"): a run of ``last_k`` periods ends ``last_k`` periods
-  after sample 0. ``CommandWatchdog`` counts the samples sent and zeroes the effort when
-  commands stop; ``RealtimeStats`` counts commands before the next tick, and overruns.
+  newest valid command, steps the plant one period, stamps the sample with the system clock. A
+  tick a period late is an overrun; the grid points it passed are lost (docs/running.md, "Clock
+  modes"). ``CommandWatchdog`` zeroes the effort when commands stop; ``RealtimeStats`` counts.
 
 Every command passes the ``CommandGuard`` first; ``CommandNews`` says what the loop has to say
-of the commands; ``LoopPort``, the node, does what the loop says.
-"""
+of the commands; ``LoopPort``, the node, does what the loop says."""
 
 from __future__ import annotations
 

@@ -1,20 +1,16 @@
 """The simulated slide: plant, encoder, force sensor and hand in one stepping object.
 
 The plant's physics is ``SlideDeviceParams`` (``haptic_sim.slide.plant``: stiction, Stribeck
-friction and the amplifier's lag beyond the thesis's model).
-Plant ``(m + m_h) x'' = F_a + F_grip - c x' - F_f``, ``F_grip = k_h (x_r - x) + b_h (x_r' - x') +
-f_ff`` (the hand).
+friction and the amplifier's lag beyond the thesis's model): ``(m + m_h) x'' = F_a + F_grip -
+c x' - F_f``, ``F_grip = k_h (x_r - x) + b_h (x_r' - x') + f_ff`` (the hand).
 
-Integration: ``substeps`` physics steps per control period (at least 10 kHz at 1 kHz control),
-each the exact solution of the linear part (mass, viscous friction, grip spring and damper; the
-2x2 matrix exponential computed once) with the applied force (its mean over the step), the hand's
-reference and the friction held over the step. Exact integration matters: a semi-implicit Euler
-step moves the mass ahead of the held force by ``T / (2 n)`` and raises the open-loop onset by
-``n / (n-1)``. The command is held over the period (zero-order hold) and saturated at
-``max_force_n``. The encoder quantizes to ``encoder_resolution_m`` (after a white noise of
-``encoder_noise_m``, 0 by default); velocity is the backward difference of the encoder positions,
-as a real device's driver computes it.
-"""
+``substeps`` physics steps per control period (at least 10 kHz at 1 kHz control), each the exact
+solution of the linear part (a 2x2 matrix exponential computed once) with the applied force, the
+hand's reference and the friction held over the step: a semi-implicit Euler step would move the
+mass ahead of the held force by ``T / (2 n)``. The command is held over the period and saturated
+at ``max_force_n``. The encoder quantizes to ``encoder_resolution_m`` (after a white noise of
+``encoder_noise_m``); velocity is the backward difference of the encoder positions, as a real
+driver computes it."""
 
 from __future__ import annotations
 

@@ -1,28 +1,19 @@
 """The identification chain through the bridge, in real time, for each test driver (issue 31).
 
 What docs/devices.md tells a lab to type, against a test driver whose plant's truth the test
-knows: the excitation session (``haptic-launch <config> --params excite/<device> --record``:
-a multisine along each axis within the clamp, nobody holding the stylus, the bridge composed
-with the loop) -> ``haptic-identify`` on that bag (``--axes`` for the Force Dimension writing
-the model's YAML, the arm's whole model ``--urdf ... --tip-frame tip --inertial --write-urdf``
-for the Touch) -> a DOB session with it (``--params MODEL`` or ``--set NODE:urdf_path=URDF``,
-and ``--set controller_node:mode=DOB``), recorded, the simulated hand pushing into the config's
-wall. The estimate the bag holds is matched by stamp with the hand force the driver's plant
-knows; the figure is the RMS of the 3-D error over the true force's span along the
-wall's normal, in contact after the hand's 2 s ramp (as ``test_point_mass_chain.py``).
+knows: the excitation session (``haptic-launch <config> --params excite/<device> --record``) ->
+``haptic-identify`` on that bag (``--axes`` for the Force Dimension, ``--inertial --write-urdf``
+for the Touch) -> a recorded DOB session with that model, the simulated hand pushing into the
+wall. The figure is the RMS of the estimate's 3-D error (matched by stamp with the plant's hand
+force) over the true force's span, in contact after the hand's 2 s ramp.
 
-- forcedimension_ros2-like (1 kHz, config/point_mass_sim.yaml's device underneath): the
-  mass within 5 % and the viscous friction within 10 % of the plant on every axis, the estimate
-  within 5 %.
-- Touch-like (500 Hz, best-effort position-only states, the white button gating the force;
-  config/phantom_omni_sim.yaml's Touch underneath): the payload's gravity torque within 5 %, the
-  Coulomb friction within 20 % and the estimate within 12 %; issue 31's viscous friction and 5 %
-  are not reached (docs/devices.md says why) and the test says so with its figures (xfail).
+- forcedimension_ros2-like (1 kHz): mass within 5 %, viscous friction within 10 %, estimate 5 %.
+- Touch-like (500 Hz, best-effort position-only states, the white button): the payload's gravity
+  torque within 5 %, Coulomb friction within 20 %, the estimate within 12 %; issue 31's viscous
+  friction and 5 % are not reached (docs/devices.md says why): xfail with the figures.
 
-Each skips where the suite's capacity measurement says this machine cannot carry the composed
-loop and its recorder in real time now, or where the Python test driver itself did not hold its
-rate (a real driver does).
-"""
+Each skips where the capacity measurement says this machine cannot carry the composed loop and
+its recorder in real time now, or the Python test driver did not hold its rate."""
 
 from __future__ import annotations
 

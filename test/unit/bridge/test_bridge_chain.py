@@ -1,25 +1,18 @@
 """The identification chain through the bridge's own code, in batch (issue 31).
 
-Each device's chain as a lab runs it, every command on time (``support.bridge_batch``: the test
-driver's plant and semantics, ``StateReader`` and ``BridgeLoop``, the loop's stages): the
-excitation session (the bridge config with ``config/excite/<device>.yaml`` laid over it, as
-``haptic-launch --params`` lays it) -> the loop's ``joint_states`` as ``--record`` writes them,
-into a bag -> ``haptic-identify`` on that bag -> a DOB session with the YAML it wrote, the hand
-pushing into the config's wall. The real-time graph test
-(``test/graph/realtime/test_bridge_chain.py``) runs the same chain through the processes; this
-one is deterministic and carries on where a loaded machine makes that one skip.
+Each device's chain as a lab runs it, every command on time (``support.bridge_batch``): the
+excitation session (the bridge config with ``config/excite/<device>.yaml`` laid over it) -> the
+loop's ``joint_states`` into a bag -> ``haptic-identify`` on that bag -> a DOB session with the
+model it wrote, the hand pushing into the wall. Deterministic; it carries on where a loaded
+machine makes the real-time test (``test/graph/realtime/test_bridge_chain.py``) skip.
 
-- Force Dimension (``config/bridge_forcedimension.yaml``, the point-mass device of
-  ``config/point_mass_sim.yaml`` underneath): every axis's mass within 5 % and viscous friction
-  within 10 % of the plant's truth, the estimate within 5 % RMS of the true hand force's span
-  in contact.
-- Touch (``config/bridge_touch.yaml``, ``config/phantom_omni_sim.yaml``'s simulated Touch
-  underneath): the inertial identification (``--inertial --write-urdf``) finds the 12 g payload
-  the URDF lacks (the arm's D(q) and G(q) within 5 %) and each joint's Coulomb friction, and the
+- Force Dimension (``config/point_mass_sim.yaml``'s device underneath): every axis's mass within
+  5 % and viscous friction within 10 % of the plant's truth, the estimate within 5 % RMS of the
+  true hand force's span in contact.
+- Touch (``config/phantom_omni_sim.yaml``'s Touch underneath): ``--inertial`` finds the 12 g
+  payload the URDF lacks (D(q) and G(q) within 5 %) and each joint's Coulomb friction, and the
   DOB on its URDF does as well as on the plant's truth; the viscous friction within 10 % and the
-  estimate within 5 % are not reached and the test says so with the figures (docs/devices.md:
-  the viscous friction too small to resolve, the estimate limited by the encoder).
-"""
+  estimate within 5 % are not reached (docs/devices.md says why): xfail with the figures."""
 
 from __future__ import annotations
 

@@ -6,13 +6,11 @@ be woken at a time (``next_wakeup``) for real-time ticks, and may say they are `
 exception out of any node's callback ends the process, but first every node's ``on_shutdown``
 runs (``last_words``): a device or a bridge to a real driver sends its zero.
 
-At a clean stop a process whose nodes all report a ``drain_marker`` (the observer) first works
-off the inputs still coming, until the marker stops changing for ``DRAIN_QUIET_S`` and
-``QUIET_SPINS`` spins, for at most a full input queue of samples (``WORK_OFF_SAMPLES``); then
-every process waits until its reliable readers acknowledged what it published, within
-``DRAIN_BUDGET_S``. A device node has no marker: it zeroes its effort at once. A process stops
-when a node finishes, once every node of it that ends its run by itself (``finishes_run``) has: a
-teleoperation graph's master and slave composed both finish their runs.
+At a clean stop an observer (a ``drain_marker``) first works off the inputs still coming, until
+its marker stays still for ``DRAIN_QUIET_S`` and ``QUIET_SPINS`` spins, for at most a queue of
+samples (``WORK_OFF_SAMPLES``); then every process waits for its reliable readers'
+acknowledgements, within ``DRAIN_BUDGET_S``. A device zeroes its effort at once. A process stops
+when each of its nodes that ends its run by itself (``finishes_run``) has finished.
 """
 
 from __future__ import annotations
