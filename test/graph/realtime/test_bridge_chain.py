@@ -12,8 +12,7 @@ force) over the true force's span, in contact after the hand's 2 s ramp.
   torque within 5 %, Coulomb friction within 20 %, the estimate within 12 %; issue 31's viscous
   friction and 5 % are not reached (docs/devices.md says why): xfail with the figures.
 
-Each skips where the capacity measurement says this machine cannot carry the composed loop and
-its recorder in real time now, or the Python test driver did not hold its rate."""
+Each skips where this machine cannot carry the loop and its recorder in real time now."""
 
 from __future__ import annotations
 
