@@ -110,6 +110,13 @@ ROWS = [
     _row("realtime", "a process per node, OL, 3 s, as `test_graph_realtime` runs it: median "
          "latency against three raw hops (the slower of before and after)",
          "benchmarks.py", "realtime-margin", "--repeat", "3"),
+    _row("bridge", "the bridge composed with the loop against a test driver (Force Dimension-"
+         "like at 1 kHz, Touch-like at 500 Hz), 10 s: driver state -> command latency against "
+         "one raw hop, commands before the driver's next state", "benchmarks.py", "bridge",
+         "--repeat", "5"),
+    _row("bridge", "the same, the loop and the driver under SCHED_FIFO 50 (`--rt-priority 50`; "
+         "the driver under `chrt -f 50`, as a controller manager runs)", "benchmarks.py",
+         "bridge", "--repeat", "5", "--rt-priority", "50"),
     _row("logging", "one log call in a node's process (the device's modules loaded): rclpy's "
          "logger and `LoopLog`, first call, said, throttled away", "benchmarks.py", "log",
          "--repeat", "3"),

@@ -12,7 +12,7 @@ At tick k+1 the plant moves over [k, k+1) with the effort in force (ros2_control
 written at tick k; Touch: the newest force), then state k+1 goes out stamped with the first
 tick's time plus k+1 periods: the instant its positions are true, as a real driver's stamp is
 (not the Python tick's jittery wall time). Command k is on time when it answers state k and
-arrives before tick k+1."""
+arrives before tick k+1 (or, ``within_period``, within a period of the state going out)."""
 
 from __future__ import annotations
 
@@ -90,6 +90,8 @@ class DriverNode(LoopNode):
         self._t_sent = 0.0
         self._answered = -1  # the newest stamp a command answered on time
         self.on_time = self.late = self.missed_ticks = self.states = 0
+        self._unanswered = 0  # ticks since the last on-time command: late once another comes
+        self.within_period = 0  # on-time commands that came within a period of their state
         self.latency = LatencyHistogram()
         #: per tick: stamp, monotonic s, published (1/0), q..., effort..., hand (3), tip (3)
         self.ticks: list[tuple[float, ...]] = []
@@ -107,7 +109,9 @@ class DriverNode(LoopNode):
         if stamp_ns == self._stamp and self._answered != self._stamp:
             self._answered = self._stamp
             self.on_time += 1
+            self.late, self._unanswered = self.late + self._unanswered, 0
             self.latency.add(now - self._t_sent)
+            self.within_period += now - self._t_sent < self.period_s
 
     def _on_button(self, msg: Any) -> None:
         self._button = bool(msg.data)
@@ -124,7 +128,7 @@ class DriverNode(LoopNode):
             self.get_logger().info(f"{TICKING} at {self.cfg['rate_hz']} Hz")
         if self._k >= 0:
             if self._answered != self._stamp and self.on_time:
-                self.late += 1
+                self._unanswered += 1
             effort = self._effort()
             self._resting = self._resting and not any(self._force)
             if not self._resting:
@@ -190,7 +194,9 @@ class DriverNode(LoopNode):
             "ticks": self._k,
             "commands": len(self.commands),
             "commands_on_time": self.on_time,
-            "commands_late": self.late,
+            "commands_late": self.late,  # between on-time ones: the loop's end is not late
+            "ticks_after_last_command": self._unanswered,
+            "commands_within_period": self.within_period,
             "missed_ticks": self.missed_ticks,
             "latency_p50_ms": self.latency.percentile(50) * 1e3,
             "latency_p99_ms": self.latency.percentile(99) * 1e3,

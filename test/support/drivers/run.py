@@ -39,15 +39,17 @@ SLIDE_HAND = {
 }
 
 
-def start(cfg: dict[str, Any], env: dict[str, str], directory: Path) -> Process:
+def start(
+    cfg: dict[str, Any], env: dict[str, str], directory: Path, prefix: Sequence[str] = ()
+) -> Process:
     """The driver of ``cfg`` (``node.py``'s keys; ``out`` defaults to ``directory``), ticking
     (its start-up may take seconds on a loaded machine: a session started before would run
-    without it)."""
+    without it). ``prefix`` goes before the command (``chrt -f 50``: as a real driver runs)."""
     directory.mkdir(parents=True, exist_ok=True)
     cfg = {"out": str(directory), **cfg}
     path = directory / "driver.json"
     path.write_text(json.dumps(cfg))
-    proc = Process([sys.executable, str(NODE), str(path)], env, directory / "driver.log")
+    proc = Process([*prefix, sys.executable, str(NODE), str(path)], env, directory / "driver.log")
     if not wait_until(lambda: "ticking" in proc.output() or proc.proc.poll() is not None, 120.0):
         proc.stop()
         raise TimeoutError(f"the test driver did not start ticking:\n{proc.output()[-2000:]}")
