@@ -16,7 +16,12 @@ from typing import Any
 
 import pytest
 
+from haptic_dob.runtime.ros.dds_profile import use_default_profile
 from support.paths import ROOT
+
+# the tests' own endpoints (collectors, a driver's controls) speak DDS as the suite's processes
+# do: the profile's 50 ms heartbeats repair a lost discovery message in time for a short run
+use_default_profile()
 
 GRAPH = ROOT / "test" / "graph"
 REALTIME = GRAPH / "realtime"

@@ -45,7 +45,7 @@ def test_external_joint_torques_in_the_drivers_names(tmp_path) -> None:
     )
     try:
         assert wait_until(lambda: "the loop is up" in graph.output(), 120.0), graph.output()
-        controls.press(True)
+        controls.hold(graph.output)
         assert graph.wait(120) == 0, graph.output()
         time.sleep(0.3)
     finally:

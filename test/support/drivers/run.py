@@ -13,7 +13,8 @@ from __future__ import annotations
 import json
 import os
 import sys
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,7 @@ from support.rosgraph import Process, isolated_env, launch
 from support.waits import wait_until
 
 NODE = Path(__file__).resolve().parent / "node.py"
+DEADMAN_HELD = "dead-man held"  # the bridge's line when the button is held
 
 #: a hand like slide_sim's: a 2 N push with a slow semi-random swing, held by a soft grip
 SLIDE_HAND = {
@@ -79,7 +81,7 @@ def bridge_session(
         if controls is not None:
             up = "the loop is up"
             assert wait_until(lambda: up in graph.output(), 120.0), graph.output()
-            controls.press(True)
+            controls.hold(graph.output)
         assert graph.wait(180) == 0, graph.output()
     finally:
         graph.stop()
@@ -116,6 +118,18 @@ class Controls:
     def press(self, held: bool) -> None:
         """Hold (or let go of) the stylus's white button."""
         self._button.publish(self._bool(data=held))
+
+    def hold(self, output: Callable[[], str], tries: int = 5, wait_s: float = 10.0) -> None:
+        """Press the white button until the bridge says it sees it held (``output``: the bridge's
+        log so far), as a user presses again: the driver publishes the button only on change, so
+        a press before the bridge's subscription matched the driver's publisher is lost."""
+        for _ in range(tries):
+            self.press(True)
+            if wait_until(lambda: DEADMAN_HELD in output(), wait_s):
+                return
+            self.press(False)
+            time.sleep(0.5)  # the driver takes the release before the next press
+        raise AssertionError(f"the bridge never saw the button held:\n{output()[-2000:]}")
 
     def pause(self, seconds: float) -> None:
         """The driver publishes no state for ``seconds``."""
