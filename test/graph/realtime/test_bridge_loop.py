@@ -31,6 +31,9 @@ pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 LOOP = ["bridge_node", "environment_node", "observer_node", "controller_node"]
 RUN_S = 4.0
 DRIVER_SHARE = 0.95  # the test driver's ticks over its periods, at least
+#: commands before the driver's next state, at least, for the estimate's figure: a late command
+#: acts a period after the effort the bridge reports (as test_bridge_chain.py presumes)
+ON_TIME = 0.90
 SLIDE_LOOP = ["device_node", "environment_node", "observer_node", "controller_node"]
 
 
@@ -170,4 +173,13 @@ def test_arm_as_teleoperation_slave_through_the_bridge(tmp_path) -> None:
     assert contact.sum() >= 500, "the slave never pressed on the table"
     err = est_z[contact] - true_z[contact]
     span = true_z[contact].max() - true_z[contact].min()
-    assert np.sqrt(np.mean(err**2)) < 0.1 * max(span, 10.0)
+    rms, bound = float(np.sqrt(np.mean(err**2))), 0.1 * max(span, 10.0)
+    c = truth.counts
+    on_time = c["commands_on_time"] / max(1, c["commands_on_time"] + c["commands_late"])
+    if on_time < ON_TIME:
+        pytest.skip(
+            f"{100 * on_time:.1f} % of the commands reached the test driver before its next "
+            f"state on this machine now (the estimate presumes {100 * ON_TIME:g} %); measured "
+            f"anyway: the estimate {rms:.2f} N RMS in contact (bound {bound:.2f} N)"
+        )
+    assert rms < bound, (rms, bound)
