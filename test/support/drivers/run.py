@@ -114,15 +114,18 @@ class Controls:
         self._bool, self._float = Bool, Float64
         self._button = self.node.create_publisher(Bool, f"{ns}/test/button", LATCHED)
         self._pause = self.node.create_publisher(Float64, f"{ns}/test/pause", LATCHED)
+        self._buttons = f"{ns}/buttons"  # the driver's Joy, which the bridge subscribes to
 
     def press(self, held: bool) -> None:
         """Hold (or let go of) the stylus's white button."""
         self._button.publish(self._bool(data=held))
 
-    def hold(self, output: Callable[[], str], tries: int = 5, wait_s: float = 10.0) -> None:
-        """Press the white button until the bridge says it sees it held (``output``: the bridge's
-        log so far), as a user presses again: the driver publishes the button only on change, so
-        a press before the bridge's subscription matched the driver's publisher is lost."""
+    def hold(self, output: Callable[[], str], tries: int = 5, wait_s: float = 2.0) -> None:
+        """Press the white button once the bridge subscribes to the driver's buttons, again until
+        the bridge says it sees it held (``output``: the bridge's log so far), as a user presses
+        again: the driver publishes the button only on change, so a press before the bridge's
+        subscription matched the driver's publisher is lost."""
+        wait_until(lambda: self.node.count_subscribers(self._buttons) > 0, 60.0)
         for _ in range(tries):
             self.press(True)
             if wait_until(lambda: DEADMAN_HELD in output(), wait_s):
