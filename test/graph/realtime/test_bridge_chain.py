@@ -31,19 +31,13 @@ from haptic_dob.core.models import UrdfModel
 from haptic_dob.runtime.params import build, load_node_params, node_view
 from support.capacity import hop_floor_us, require_hop_floor, require_realtime
 from support.drivers import plants
-from support.drivers.run import SLIDE_HAND, Truth, bridge_session
+from support.drivers.run import DRIVER_SHARE, ON_TIME, SLIDE_HAND, Truth, bridge_session
 from support.paths import ROOT, tool
 
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
 CONFIG = ROOT / "config"
 SLIDE_LOOP = ["device_node", "environment_node", "observer_node", "controller_node"]
-DRIVER_SHARE = 0.95  # the test driver's ticks over its periods, at least
-#: commands before the driver's next state, at least: a late one acts a period after the effort
-#: the bridge reports. At 92-97 % on time the figures were those of every command on time
-#: (test_bridge_chain in batch); at 56 % the viscous friction came out 9 % low. The loop's own
-#: timing (issue 31: 99 % beside a CPU hog) is test_bridge_loop's and BENCHMARKS.md's.
-ON_TIME = 0.90
 DOB_S = 8.0  # the hand's 1 s ramp, 2 s settling, 5 s in contact
 SETTLE_S = 2.0
 WRENCH = "geometry_msgs/msg/WrenchStamped"

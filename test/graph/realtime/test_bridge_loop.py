@@ -22,7 +22,7 @@ import pytest
 
 from haptic_dob.core.models.urdf import UrdfModel
 from support.capacity import hop_floor_us, require_hop_floor, require_realtime
-from support.drivers.run import SLIDE_HAND, Truth, bridge_session, start
+from support.drivers.run import DRIVER_SHARE, ON_TIME, SLIDE_HAND, Truth, bridge_session, start
 from support.paths import ROOT
 from support.rosgraph import Collector, isolated_env, launch
 
@@ -30,10 +30,6 @@ pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
 LOOP = ["bridge_node", "environment_node", "observer_node", "controller_node"]
 RUN_S = 4.0
-DRIVER_SHARE = 0.95  # the test driver's ticks over its periods, at least
-#: commands before the driver's next state, at least, for the estimate's figure: a late command
-#: acts a period after the effort the bridge reports (as test_bridge_chain.py presumes)
-ON_TIME = 0.90
 SLIDE_LOOP = ["device_node", "environment_node", "observer_node", "controller_node"]
 
 

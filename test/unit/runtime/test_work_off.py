@@ -5,7 +5,8 @@ from __future__ import annotations
 import time
 from typing import Any, cast
 
-from haptic_dob.runtime.ros.spin import DRAIN_QUIET_S, LoopNode, work_off
+from haptic_dob.runtime.ros.spin import LoopNode
+from haptic_dob.runtime.ros.stop import DRAIN_QUIET_S, work_off
 
 
 class Draining:

@@ -6,11 +6,10 @@ be woken at a time (``next_wakeup``) for real-time ticks, and may say they are `
 exception out of any node's callback ends the process, but first every node's ``on_shutdown``
 runs (``last_words``): a device or a bridge to a real driver sends its zero.
 
-At a clean stop an observer (a ``drain_marker``) first works off the inputs still coming, until
-its marker stays still for ``DRAIN_QUIET_S`` and ``QUIET_SPINS`` spins, for at most a queue of
-samples (``WORK_OFF_SAMPLES``); then every process waits for its reliable readers'
-acknowledgements, within ``DRAIN_BUDGET_S``. A device zeroes its effort at once. A process stops
-when each of its nodes that ends its run by itself (``finishes_run``) has finished.
+At a clean stop (``runtime.ros.stop``) an observer first works off the inputs still coming, then
+every process waits for its reliable readers' acknowledgements. A device zeroes its effort at
+once. A process stops when each of its nodes that ends its run by itself (``finishes_run``) has
+finished.
 """
 
 from __future__ import annotations
@@ -27,7 +26,6 @@ from typing import Any
 import rclpy
 from rclpy._rclpy_pybind11 import RCLError, UnknownROSArgsError
 from rclpy.context import Context
-from rclpy.duration import Duration
 from rclpy.exceptions import InvalidParameterValueException, ParameterException
 from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.experimental.events_executor import EventsExecutor
@@ -43,17 +41,17 @@ from haptic_dob.runtime.params import ParamSpec
 from haptic_dob.runtime.ros.dds_profile import use_default_profile
 from haptic_dob.runtime.ros.log import LoopLog
 from haptic_dob.runtime.ros.params import ParameterTable
+from haptic_dob.runtime.ros.stop import (
+    DRAIN_BUDGET_S,
+    last_words,
+    wait_for_acknowledgements,
+    work_off,
+)
 from haptic_dob.runtime.ros_args import shadow_line, shadowed
 from haptic_msgs_py.bus import bus_for
-from haptic_msgs_py.ros.qos import LOOP_IN_DEPTH
 
 EXECUTORS = ("events", "single")
-DRAIN_BUDGET_S = 2.0  # at most this long for the acknowledgements at a stop
-DRAIN_QUIET_S = 0.2  # inputs are worked off when the marker did not change for this long
-QUIET_SPINS = 5  # ... and over this many spins
-WORK_OFF_SAMPLES = LOOP_IN_DEPTH  # ... or after this many changes: what a queue held at the stop
 WORK_OFF_S = 10.0  # ... or, a backstop, after this long
-LAST_WORDS_S = 0.5  # after an error: how long the zero's acknowledgement may take
 #: while nodes of this process hand the loop around in process (lockstep), the executor (DDS
 #: from other processes, services, timers) gets a turn at least this often (s)
 SOON_SLICE_S = 0.004
@@ -303,49 +301,3 @@ def run_nodes(
             os.close(latency_fd)
         for s, h in old.items():
             signal.signal(s, h)
-
-
-def last_words(nodes: Sequence[LoopNode]) -> None:
-    """Each node's ``on_shutdown`` after an error ended the spin loop (a device or a bridge
-    zeroes its effort), whatever else fails meanwhile; then a short wait for the readers'
-    acknowledgements."""
-    for n in nodes:
-        try:
-            n.on_shutdown()
-        except Exception as exc:  # the error that ended the loop is raised next
-            print(f"ERROR: {n.get_name()}: shutdown after an error failed: {exc}", file=sys.stderr)
-    wait_for_acknowledgements(nodes, time.monotonic() + LAST_WORDS_S)
-
-
-def work_off(
-    spin_once: Callable[..., None],
-    nodes: Sequence[LoopNode],
-    until: float,
-    samples: int = WORK_OFF_SAMPLES,
-) -> int:
-    """Spin until no node's ``drain_marker`` changed for ``DRAIN_QUIET_S`` and ``QUIET_SPINS``
-    spins (a starved process's spins, not the wall clock, say its inputs stopped), or the
-    markers changed ``samples`` times, or ``until`` (monotonic s); the number of changes."""
-    last = [n.drain_marker() for n in nodes]
-    quiet_since, quiet_spins, changes = time.monotonic(), 0, 0
-    while time.monotonic() < until and changes < samples:
-        if quiet_spins >= QUIET_SPINS and time.monotonic() - quiet_since >= DRAIN_QUIET_S:
-            break
-        spin_once(timeout_sec=DRAIN_QUIET_S / QUIET_SPINS)
-        markers = [n.drain_marker() for n in nodes]
-        if markers != last:
-            last, quiet_since, quiet_spins = markers, time.monotonic(), 0
-            changes += 1
-        else:
-            quiet_spins += 1
-    return changes
-
-
-def wait_for_acknowledgements(nodes: Sequence[Node], until: float) -> bool:
-    """Wait until every reliable reader acknowledged what ``nodes`` published (or ``until``)."""
-    for node in nodes:
-        for pub in node.publishers:
-            left = until - time.monotonic()
-            if left <= 0.0 or not pub.wait_for_all_acked(Duration(nanoseconds=int(left * 1e9))):
-                return False
-    return True
