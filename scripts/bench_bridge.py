@@ -1,17 +1,15 @@
 """The device bridge's latency: a test driver's state to its command, against the raw DDS hop.
 
-Each run starts a test driver (``test/support/drivers``: the forcedimension_ros2-like one at
-1 kHz, the Touch-like one at 500 Hz with best-effort states and the stylus button held) and
-``haptic-launch`` of its config (``bridge_forcedimension``, ``bridge_touch``: the bridge composed
-with the loop, OL wall, the hand pushing into it) for ``RUN_S`` seconds on a fresh domain id,
-and measures one raw hop (``dds_hop``) just before and just after it. The driver measures what
-matters to a device: from publishing state k to receiving command k (two hops and the loop), and
-whether command k arrived before it published state k+1 (on time; and within a period of state
-k, which a driver on a steady clock would see: the Python driver's own jitter apart). The
-figure is that latency's median against the slower raw hop of the run: the floor is two hops.
-``GRAPH_ARGS`` go to
-``haptic-launch``; with ``--rt-priority P`` the driver runs under ``chrt -f P`` too, as a real
-driver's controller manager runs.
+Each run starts a test driver (``test/support/drivers``, ``PROFILES``: Force Dimension-like at
+1 kHz, Touch-like at 500 Hz with the stylus button held, a Franka-like arm at 1 kHz as a
+teleoperation slave) and ``haptic-launch`` of its config for ``RUN_S`` seconds on a fresh domain
+id, with one raw hop (``dds_hop``) measured before and after. The driver measures what matters to
+a device: from publishing state k to receiving command k, and whether command k came before state
+k+1 (on time; and within a period of state k, the Python driver's own jitter apart). The figure
+is that latency's median against the slower raw hop: the floor is two hops. ``GRAPH_ARGS`` go to
+``haptic-launch``; with ``--rt-priority P`` the driver runs under ``chrt -f P`` too, as a
+controller manager runs. ``CPUS`` (``--cpus LIST``): the driver and the loop under ``taskset -c
+LIST``, on the CPUs the machine stalls least (``timer-floor``; docs/running.md).
 """
 
 from __future__ import annotations
@@ -34,10 +32,15 @@ from haptic_dob.runtime.ros.dds_hop import hop_us  # noqa: E402
 from support.drivers.run import SLIDE_HAND, Controls, Truth, start  # noqa: E402
 
 RUN_S = 10.0
-PROFILES = {
+#: ``taskset -c`` CPU list of the driver and the loop (``--cpus``); empty: the process's CPUs
+CPUS: list[str] = []
+#: name -> (config, the test driver, the bridge node's name in the launch, haptic-launch's extra)
+PROFILES: dict[str, tuple[str, dict[str, object], str, list[str]]] = {
     "fd": (
         "bridge_forcedimension.yaml",
         {"kind": "fd", "rate_hz": 1000.0, "hand": SLIDE_HAND, "hand_direction": [1, 0, 0]},
+        "bridge_node",
+        ["--namespace", "/haptic"],
     ),
     "touch": (
         "bridge_touch.yaml",
@@ -47,20 +50,33 @@ PROFILES = {
             "hand": {**SLIDE_HAND, "offset_m": 0.012},
             "hand_direction": [0, 0, -1],
         },
+        "bridge_node",
+        ["--namespace", "/haptic"],
+    ),
+    "arm": (  # a Franka-like ros2_control arm as the slave of the simulated slide (teleoperation)
+        "bridge_arm_teleop.yaml",
+        {"kind": "arm", "rate_hz": 1000.0, "table_z": 0.39},
+        "slave/bridge_node",
+        ["--robot-description", "/arm/robot_description"],
     ),
 }
 
 
+def cpus_prefix() -> list[str]:
+    """``taskset -c LIST`` when ``CPUS`` names CPUs, else nothing."""
+    return ["taskset", "-c", CPUS[0]] if CPUS else []
+
+
 def driver_prefix() -> list[str]:
-    """``chrt -f P`` when the graph runs under ``--rt-priority P``, else nothing."""
+    """``chrt -f P`` when the graph runs under ``--rt-priority P`` (after ``cpus_prefix``)."""
     if "--rt-priority" not in GRAPH_ARGS:
-        return []
-    return ["chrt", "-f", GRAPH_ARGS[GRAPH_ARGS.index("--rt-priority") + 1]]
+        return cpus_prefix()
+    return [*cpus_prefix(), "chrt", "-f", GRAPH_ARGS[GRAPH_ARGS.index("--rt-priority") + 1]]
 
 
 def one_run(profile: str) -> dict[str, float]:
     """One session of ``profile``: the driver's counts, the bridge's, and the raw hops."""
-    config, driver = PROFILES[profile]
+    config, driver, bridge_name, extra = PROFILES[profile]
     domain = random.randint(101, 200)
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
     hop_before = hop_us(2000, domain_id=domain)
@@ -68,9 +84,10 @@ def one_run(profile: str) -> dict[str, float]:
         d = Path(tmp)
         drv = start(driver, env, d / "driver", driver_prefix())
         controls = Controls(env, "/touch") if profile == "touch" else None
-        argv = [str(Path(sys.executable).parent / "haptic-launch"), str(ROOT / "config" / config)]
-        argv += ["--namespace", "/haptic", "--set", f"bridge_node:duration_s={RUN_S}"]
-        argv += ["--set", f"bridge_node:stats_file={d / 'bridge.json'}"]
+        launch = str(Path(sys.executable).parent / "haptic-launch")
+        argv = [*cpus_prefix(), launch, str(ROOT / "config" / config)]
+        argv += [*extra, "--set", f"{bridge_name}:duration_s={RUN_S}"]
+        argv += ["--set", f"{bridge_name}:stats_file={d / 'bridge.json'}"]
         argv += [a for a in GRAPH_ARGS if a != "--pin"]  # one process: nothing to pin
         graph = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
         try:

@@ -28,7 +28,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_analysis
 import bench_models
 import benchmarks
-from bench_graph import GRAPH_ARGS
 
 ROOT = Path(__file__).resolve().parents[1]
 HEADER = ("What", "Figure", "Command", "Machine", "Date")
@@ -63,9 +62,9 @@ class TableRow:
         repeat = int(self.args[self.args.index("--repeat") + 1])
         if self.script == "bench_models.py":
             return bench_models.BENCHMARKS[self.name](repeat)
-        sets = [self.args[i + 1] for i, a in enumerate(self.args) if a == "--set"]
-        GRAPH_ARGS[:] = [x for s in sets for x in ("--set", s)]
-        return benchmarks.BENCHMARKS[self.name](repeat)
+        a = benchmarks.parser().parse_args(list(self.args))  # every option, as the Command's
+        benchmarks.apply(a)
+        return benchmarks.BENCHMARKS[self.name](a.repeat)
 
 
 def _row(area: str, what: str, script: str, *args: str) -> TableRow:
@@ -111,12 +110,15 @@ ROWS = [
          "latency against three raw hops (the slower of before and after)",
          "benchmarks.py", "realtime-margin", "--repeat", "3"),
     _row("bridge", "the bridge composed with the loop against a test driver (Force Dimension-"
-         "like at 1 kHz, Touch-like at 500 Hz), 10 s: driver state -> command latency against "
-         "one raw hop, commands before the driver's next state", "benchmarks.py", "bridge",
-         "--repeat", "5"),
+         "like at 1 kHz, Touch-like at 500 Hz, a Franka-like arm at 1 kHz as a teleoperation "
+         "slave), 10 s: driver state -> command latency against one raw hop, commands before "
+         "the driver's next state", "benchmarks.py", "bridge", "--repeat", "3"),
     _row("bridge", "the same, the loop and the driver under SCHED_FIFO 50 (`--rt-priority 50`; "
          "the driver under `chrt -f 50`, as a controller manager runs)", "benchmarks.py",
-         "bridge", "--repeat", "5", "--rt-priority", "50"),
+         "bridge", "--repeat", "3", "--rt-priority", "50"),
+    _row("bridge", "the same under SCHED_FIFO 50, the driver and the loop on CPU 1 alone "
+         "(`--cpus 1`: the CPU this machine stalls least, below)", "benchmarks.py",
+         "bridge", "--repeat", "3", "--rt-priority", "50", "--cpus", "1"),
     _row("logging", "one log call in a node's process (the device's modules loaded): rclpy's "
          "logger and `LoopLog`, first call, said, throttled away", "benchmarks.py", "log",
          "--repeat", "3"),

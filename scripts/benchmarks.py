@@ -19,7 +19,7 @@ from pathlib import Path
 # bench_timer_floor (the machine's own stalls), bench_margin (the graph against its floors)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_batch import bench_batch_session, bench_observer_update
-from bench_bridge import bench_bridge
+from bench_bridge import CPUS, bench_bridge
 from bench_graph import (
     GRAPH_ARGS,
     bench_lockstep,
@@ -69,8 +69,8 @@ BENCHMARKS: dict[str, Callable[[int], str]] = {
 }
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run the named benchmarks (default: all) and print one line each."""
+def parser() -> argparse.ArgumentParser:
+    """The command line: benchmark names, ``--repeat`` and the options of the graph ones."""
     p = argparse.ArgumentParser(description=__doc__)
     p.add_argument("names", nargs="*", help=f"benchmarks to run: {', '.join(BENCHMARKS)}")
     p.add_argument("--repeat", type=int, default=5, help="repetitions (median reported)")
@@ -99,7 +99,17 @@ def main(argv: list[str] | None = None) -> int:
         help="hold a CPU wake-up latency request of US microseconds while the graph benchmarks "
         "and timer-floor run (haptic-launch option; PM QoS, needs root)",
     )
-    a = p.parse_args(argv)
+    p.add_argument(
+        "--cpus",
+        metavar="LIST",
+        help="run the bridge benchmark's driver and loop under taskset -c LIST (e.g. 1)",
+    )
+    return p
+
+
+def apply(a: argparse.Namespace) -> None:
+    """Set the graph benchmarks' ``GRAPH_ARGS`` and the bridge's ``CPUS`` from ``a``."""
+    CPUS[:] = [a.cpus] if a.cpus else []
     GRAPH_ARGS[:] = [x for item in a.set for x in ("--set", item)]
     if a.rt_priority is not None:
         GRAPH_ARGS.extend(["--rt-priority", str(a.rt_priority)])
@@ -107,6 +117,13 @@ def main(argv: list[str] | None = None) -> int:
         GRAPH_ARGS.append("--pin")
     if a.cpu_latency is not None:
         GRAPH_ARGS.extend(["--cpu-latency", str(a.cpu_latency)])
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the named benchmarks (default: all) and print one line each."""
+    p = parser()
+    a = p.parse_args(argv)
+    apply(a)
     unknown = [n for n in a.names if n not in BENCHMARKS]
     if unknown:
         p.error(f"unknown benchmark(s) {', '.join(unknown)}; choose from {', '.join(BENCHMARKS)}")

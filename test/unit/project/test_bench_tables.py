@@ -57,3 +57,31 @@ def test_a_row_is_replaced_by_its_command_and_the_others_stay(tables: ModuleType
     assert appended[-2:] == ["| b | c | `cmd b` | B | d |", "text after"]
     with pytest.raises(ValueError, match="no table marked <!-- bench:missing -->"):
         tables.rewrite(text, "missing", new)
+
+
+def test_a_row_measures_with_every_option_of_its_command(
+    tables: ModuleType, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The Command cell is what ran: ``--rt-priority``, ``--cpus`` and ``--set`` reach the
+    benchmark (they once went missing, and a SCHED_FIFO row measured default scheduling)."""
+    import bench_bridge
+    import bench_graph
+
+    seen: list[tuple[list[str], list[str], int]] = []
+
+    def fake(repeat: int) -> str:
+        seen.append((list(bench_graph.GRAPH_ARGS), list(bench_bridge.CPUS), repeat))
+        return "figures"
+
+    monkeypatch.setitem(tables.benchmarks.BENCHMARKS, "bridge", fake)
+    row = tables.TableRow(
+        "bridge",
+        "w",
+        "benchmarks.py",
+        ("bridge", "--repeat", "2", "--rt-priority", "50", "--cpus", "1", "--set", "a:b=1"),
+    )
+    assert row.measure() == "figures"
+    assert seen == [(["--set", "a:b=1", "--rt-priority", "50"], ["1"], 2)]
+    plain = tables.TableRow("bridge", "w", "benchmarks.py", ("bridge", "--repeat", "1"))
+    plain.measure()
+    assert seen[-1] == ([], [], 1)
