@@ -169,9 +169,13 @@ def _busy_s(cpus: set[int]) -> float:
 
 
 def _children(pid: int) -> list[int]:
-    """The child processes of ``pid`` (the launcher's nodes)."""
+    """The child processes of ``pid`` (the launcher's nodes; none once it has exited)."""
     out: list[int] = []
-    for task in Path(f"/proc/{pid}/task").glob("*"):
+    try:
+        tasks = list(Path(f"/proc/{pid}/task").iterdir())
+    except OSError:  # the launcher ended between two samples
+        return out
+    for task in tasks:
         try:
             out += [int(c) for c in (task / "children").read_text().split()]
         except OSError:

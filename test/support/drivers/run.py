@@ -213,6 +213,15 @@ class Truth:
         periods = (self.times[-1] - self.times[0]) * float(self.info["rate_hz"])
         return (len(self.times) - 1) / periods if periods > 0 else 0.0
 
+    def answered_share(self) -> float:
+        """Of the states published from the first one a command answered to the last, the share
+        some command answered (a gate that closed in between, or states lost, lower it)."""
+        got = np.unique(self.answered[self.answered >= 0])
+        if len(got) == 0:
+            return 0.0
+        sent = self.stamps[self.published & (self.stamps >= got[0]) & (self.stamps <= got[-1])]
+        return float(np.isin(sent, got).mean())
+
     def tick_of(self, stamp_ns: int) -> int:
         """The index of the tick whose state carried ``stamp_ns``."""
         return int(np.searchsorted(self.stamps, stamp_ns))
