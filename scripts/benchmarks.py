@@ -34,6 +34,7 @@ from bench_log import bench_log
 from bench_margin import bench_margin, bench_realtime_margin
 from bench_pattern import bench_pattern
 from bench_timer_floor import bench_timer_floor
+from haptic_dob.runtime.cpus import checked_cpus
 
 
 def machine() -> str:
@@ -102,7 +103,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--cpus",
         metavar="LIST",
-        help="run the bridge benchmark's driver and loop under taskset -c LIST (e.g. 1)",
+        help="run the bridge benchmark's driver and loop under taskset -c LIST (CPU numbers, "
+        "comma-separated, e.g. 1)",
     )
     return p
 
@@ -123,6 +125,15 @@ def main(argv: list[str] | None = None) -> int:
     """Run the named benchmarks (default: all) and print one line each."""
     p = parser()
     a = p.parse_args(argv)
+    if a.cpus:
+        try:
+            numbers = [int(c) for c in a.cpus.split(",")]
+        except ValueError:
+            p.error(f"--cpus {a.cpus}: not a comma-separated list of CPU numbers")
+        try:
+            a.cpus = ",".join(map(str, checked_cpus(numbers)))
+        except ValueError as exc:  # a CPU this process may not use
+            p.error(f"--cpus {a.cpus}: {str(exc).removeprefix('cpu_affinity: ')}")
     apply(a)
     unknown = [n for n in a.names if n not in BENCHMARKS]
     if unknown:
