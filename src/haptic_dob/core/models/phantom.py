@@ -20,7 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from haptic_dob.core.models._pinocchio import PinocchioModel, TreeJoint, tree_model
+from haptic_dob.core.models._pinocchio import PinocchioModel
+from haptic_dob.core.models._pinocchio_tree import TreeJoint, tree_model
 from haptic_dob.core.validation import finite_scalar, nonnegative
 from haptic_dob.runtime.params import param
 
