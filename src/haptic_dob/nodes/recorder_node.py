@@ -85,7 +85,9 @@ class RecorderNode(LoopNode):
             except (ImportError, AttributeError, ValueError):
                 raise ValueError(f"topics: {t.typename} is not an installed message type") from None
         path, period = new_bag_path(v["output"]), period_ns(v["rate_hz"])
-        self.recording = Recording(path, v["storage"], period, v["log_time"], self._offered_qos)
+        self.recording = Recording(
+            path, v["storage"], period, v["log_time"], self._offered_qos, self.log.warning
+        )
         self._t_end = time.monotonic() + v["duration_s"] if v["duration_s"] > 0 else None
         self._subs: list[tuple[Any, Callable[[bytes], None]]] = []
         kinds = [t.kind(self.resolve_topic_name(t.name)) for t in topics]

@@ -32,21 +32,31 @@ class TopicCount:
     newest_ns: int | None = None  # largest stamp written
     durable_ns: int | None = None  # largest stamp written when the bag was last made durable
 
-    def wrote(self, stamp_ns: int | None, period_ns: int) -> None:
+    def wrote(self, stamp_ns: int | None, period_ns: int) -> int:
         """Count a written message stamped ``stamp_ns`` (None: none); the loop period (ns)
-        tells how many stamps are missing before it."""
+        tells how many stamps are missing before it. Returns that number (0: none)."""
         self.written += 1
         if stamp_ns is None:
-            return
-        newest = self.newest_ns
+            return 0
+        newest, missing = self.newest_ns, 0
         if newest is None:
             self.first_ns = self.newest_ns = stamp_ns
         elif stamp_ns > newest:
             if stamp_ns - newest >= 2 * period_ns:
-                self.gaps += (stamp_ns - newest) // period_ns - 1
+                missing = (stamp_ns - newest) // period_ns - 1
+                self.gaps += missing
             self.newest_ns = stamp_ns
         elif self.first_ns is not None and stamp_ns < self.first_ns:
             self.first_ns = stamp_ns
+        return missing
+
+    def gap_line(self, missing: int, stamp_ns: int) -> str:
+        """The line a recorder logs as soon as it sees ``missing`` stamps missing before the
+        one stamped ``stamp_ns`` (they never reached it: lost on the way, or never sent)."""
+        return (
+            f"{self.topic}: {missing} stamp(s) missing before {stamp_ns} ns "
+            f"({self.gaps} in all so far)"
+        )
 
     def log_line(self) -> str:
         """``<topic>: received N, written M[, G stamp(s) missing]``."""

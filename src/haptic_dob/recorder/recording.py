@@ -39,6 +39,11 @@ METADATA_KEY = "haptic_dob.recorder"  # custom data of the bag's metadata: the c
 DURABLE_NS = 1_000_000_000  # complete records on disk every this much session time (and wall)
 
 OfferedQos = Callable[[str], Sequence["Qos"]]  # a topic -> the QoS its publishers offer
+GapReport = Callable[[str], object]  # takes the line that says which stamps are missing
+
+
+def no_report(line: str) -> None:
+    """Say nothing (a recording outside a node)."""
 
 
 def no_offers(topic: str) -> Sequence[Qos]:
@@ -62,7 +67,9 @@ class _LazyConnection:
 
 class Recording:
     """A new bag at ``path`` in ``storage``; the loop period (ns) counts missing stamps;
-    ``log_time`` one of ``LOG_TIMES``; ``offered`` the QoS profiles a topic's publishers offer.
+    ``log_time`` one of ``LOG_TIMES``; ``offered`` the QoS profiles a topic's publishers offer;
+    ``on_gap`` is told at once when a stamped topic's message comes after missing stamps
+    (``TopicCount.gap_line``), so a recorder killed later has still said what it never got.
 
     Raises ``ValueError`` saying why the bag cannot be created.
     """
@@ -74,6 +81,7 @@ class Recording:
         period_ns: int,
         log_time: str = "session",
         offered: OfferedQos = no_offers,
+        on_gap: GapReport = no_report,
     ) -> None:
         if log_time not in LOG_TIMES:
             raise ValueError(f"log_time must be one of {', '.join(LOG_TIMES)}, got {log_time!r}")
@@ -90,6 +98,7 @@ class Recording:
         self.counts = RecordingCounts()
         self.closed = False
         self._offered = offered
+        self._on_gap = on_gap
         self._connections: list[_LazyConnection] = []
         self._events: _LazyConnection | None = None  # /parameter_events, if recorded
         self._durable_ns = time.monotonic_ns()  # when everything written was last made durable
@@ -141,7 +150,9 @@ class Recording:
             else:
                 t = self.now_ns()
             write(lazy.conn or lazy.get(), t, data)
-            count.wrote(stamp, period)
+            missing = count.wrote(stamp, period)
+            if missing and stamp is not None:
+                self._on_gap(count.gap_line(missing, stamp))
             newest = count.newest_ns
             durable = count.first_ns if count.durable_ns is None else count.durable_ns
             if newest is not None and durable is not None and newest - durable >= DURABLE_NS:

@@ -19,12 +19,16 @@ def test_gaps_first_and_newest_stamps() -> None:
     c.wrote(int(10.9 * MS), MS)  # late tick: none missing
     c.wrote(int(11.0 * MS), MS)
     c.wrote(int(12.95 * MS), MS)  # 1.95 periods after the last: a late tick, none missing
-    c.wrote(int(15.1 * MS), MS)  # 2.15 periods: grid point 14 was missed
+    assert c.wrote(int(15.1 * MS), MS) == 1  # 2.15 periods: grid point 14 was missed
     assert (c.gaps, c.newest_ns) == (3, int(15.1 * MS))
+    assert c.gap_line(1, int(15.1 * MS)) == (
+        "/ee_pose: 1 stamp(s) missing before 15100000 ns (3 in all so far)"
+    )
+    assert c.wrote(16 * MS, MS) == 0
     c.wrote(None, MS)  # an unstamped message is only counted
-    assert (c.written, c.gaps) == (11, 3)
-    c.received = 11
-    assert c.log_line() == "/ee_pose: received 11, written 11, 3 stamp(s) missing"
+    assert (c.written, c.gaps) == (12, 3)
+    c.received = 12
+    assert c.log_line() == "/ee_pose: received 12, written 12, 3 stamp(s) missing"
     assert TopicCount("/x", "t", 3, 3).log_line() == "/x: received 3, written 3"
 
 

@@ -29,7 +29,8 @@ def pose_bytes(stamp_ns: int) -> bytes:
 
 @pytest.mark.parametrize("storage", STORAGES)
 def test_messages_are_written_as_they_came_and_counted(tmp_path: Path, storage: str) -> None:
-    rec = Recording(tmp_path / "bag", storage, MS)
+    said: list[str] = []
+    rec = Recording(tmp_path / "bag", storage, MS, on_gap=said.append)
     on_pose = rec.add_topic("/ee_pose", SESSION_TOPICS[EE_POSE])
     on_cmd = rec.add_topic("/effort_command", SESSION_TOPICS[EFFORT_COMMAND])
     assert not rec.records_parameter_events
@@ -38,6 +39,7 @@ def test_messages_are_written_as_they_came_and_counted(tmp_path: Path, storage: 
     sent = [pose_bytes(k * MS) for k in (0, 1, 3)]
     for data in sent:
         on_pose(data)
+    assert said == ["/ee_pose: 1 stamp(s) missing before 3000000 ns (1 in all so far)"]  # at once
     on_cmd(wire.encode(wire.float64_multi_array(command_label(2 * MS), [0.5])))
     rec.write_snapshot("/node", {"gain": 2.0, "ids": [1, 2]}, {"gain": 3, "ids": 7})
     rec.close()
