@@ -33,16 +33,9 @@ from haptic_dob.errors import InputError
 from haptic_dob.runtime.configs import resolve_config
 from haptic_dob.runtime.cpus import free_cpus, workers_for
 from haptic_sim.experiments import graph_runs, report, results
+from haptic_sim.experiments.entry import BatchJob, Experiment, GraphJob
 from haptic_sim.experiments.jsonio import from_json, to_json
-from haptic_sim.experiments.parts import (
-    EXPERIMENTS,
-    PARTS,
-    QUICK_PARTS,
-    BatchJob,
-    Experiment,
-    GraphJob,
-    save_results,
-)
+from haptic_sim.experiments.parts import EXPERIMENTS, PARTS, QUICK_PARTS, save_results
 from haptic_sim.experiments.plan import QUICK_DURATION_S
 from haptic_sim.experiments.records import ExperimentResults
 from haptic_sim.slide.session import SessionConfig

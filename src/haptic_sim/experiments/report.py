@@ -13,7 +13,8 @@ from pathlib import Path
 from typing import Any
 
 from haptic_sim.experiments.configuration import config_table
-from haptic_sim.experiments.parts import Experiment, present
+from haptic_sim.experiments.entry import Experiment
+from haptic_sim.experiments.parts import present
 from haptic_sim.experiments.records import ExperimentResults
 from haptic_sim.slide.session import SessionConfig
 

@@ -21,12 +21,12 @@ from haptic_sim.experiments import (
     spread,
     sweeps,
 )
+from haptic_sim.experiments.entry import BatchJob
 from haptic_sim.experiments.jsonio import from_json, to_json
 from haptic_sim.experiments.parts import (
     EXPERIMENTS,
     PARTS,
     QUICK_PARTS,
-    BatchJob,
     load_results,
     save_results,
 )
