@@ -50,11 +50,11 @@ class TopicCount:
             self.first_ns = stamp_ns
         return missing
 
-    def gap_line(self, missing: int, stamp_ns: int) -> str:
-        """The line a recorder logs as soon as it sees ``missing`` stamps missing before the
-        one stamped ``stamp_ns`` (they never reached it: lost on the way, or never sent)."""
+    def gap_line(self, missing: int) -> str:
+        """The line a recorder logs as soon as ``wrote`` found ``missing`` stamps missing before
+        the newest one (they never reached it: lost on the way, or never sent)."""
         return (
-            f"{self.topic}: {missing} stamp(s) missing before {stamp_ns} ns "
+            f"{self.topic}: {missing} stamp(s) missing before {self.newest_ns} ns "
             f"({self.gaps} in all so far)"
         )
 

@@ -151,8 +151,8 @@ class Recording:
                 t = self.now_ns()
             write(lazy.conn or lazy.get(), t, data)
             missing = count.wrote(stamp, period)
-            if missing and stamp is not None:
-                self._on_gap(count.gap_line(missing, stamp))
+            if missing:
+                self._on_gap(count.gap_line(missing))
             newest = count.newest_ns
             durable = count.first_ns if count.durable_ns is None else count.durable_ns
             if newest is not None and durable is not None and newest - durable >= DURABLE_NS:
