@@ -101,16 +101,29 @@ def point_mass(
     return Plant(device, {"cartesian": asdict(device.device), "config": POINT_MASS_SIM.name})
 
 
-def touch(rate_hz: float, seed: int, hand: dict[str, Any], direction: tuple[float, ...]) -> Plant:
+def touch(
+    rate_hz: float,
+    seed: int,
+    hand: dict[str, Any],
+    direction: tuple[float, ...],
+    encoder_resolution_rad: float | None = None,
+) -> Plant:
     """The Touch-like plant: the hand pushing along ``direction``; its truth the URDF's rigid
     body plus the config's payload and joint friction (the Coulomb friction turning over the
-    speeds ``coulomb_speed_rad_per_s``, the simulator's smoothing at this physics step)."""
+    speeds ``coulomb_speed_rad_per_s``, the simulator's smoothing at this physics step), its
+    encoders' counts the config's unless ``encoder_resolution_rad`` is given."""
+    encoder = (
+        {}
+        if encoder_resolution_rad is None
+        else {"arm.encoder_resolution_rad": encoder_resolution_rad}
+    )
     device = simulated(
         TOUCH_SIM,
         rate_hz=rate_hz,
         seed=seed,
         substeps=TOUCH_SUBSTEPS,
         **{"arm.hand_direction": list(direction)},
+        **encoder,
         **hand_values(hand),
     )
     assert isinstance(device, SimulatedArm) and isinstance(device.model, UrdfModel)

@@ -109,13 +109,26 @@ def test_forcedimension_dob_estimates_the_hand_within_5_percent(fd) -> None:
     assert fd[2] <= 0.05, fd[2]
 
 
-def touch_dob(config: Path, model: dict[str, Any]) -> float:
+def truth_model(truth: dict[str, Any]) -> dict[str, Any]:
+    """The Touch plant's whole truth as the observer's model (its ``urdf.*`` parameters)."""
+    return {
+        "urdf.payload_kg": truth["payload_kg"],
+        "urdf.viscous_n_m_s_per_rad": truth["viscous_n_m_s_per_rad"],
+        "urdf.coulomb_n_m": truth["coulomb_n_m"],
+        "urdf.coulomb_speed_rad_per_s": list(truth["coulomb_speed_rad_per_s"]),
+    }
+
+
+def touch_dob(
+    config: Path, model: dict[str, Any], encoder_resolution_rad: float | None = None
+) -> float:
     """The Touch's DOB session with ``model`` set on the nodes that assume one (as ``--set``
-    does), the hand pushing the stylus onto the floor: the estimate's error in contact."""
+    does), the hand pushing the stylus onto the floor: the estimate's error in contact. The
+    plant's encoder counts are its config's unless ``encoder_resolution_rad`` is given."""
     over = {n: {**model} for n in ("bridge_node", "observer_node", "controller_node")}
     over["controller_node"]["mode"] = "DOB"
     dob = session(config, over=over)
-    pusher = plants.touch(500.0, 0, TOUCH_HAND, (0.0, 0.0, -1.0))
+    pusher = plants.touch(500.0, 0, TOUCH_HAND, (0.0, 0.0, -1.0), encoder_resolution_rad)
     error, share = contact_error(run_bridge(dob, pusher, DOB_S), dob)
     assert share > 0.9, share
     return error
@@ -158,12 +171,7 @@ def test_touch_chain_finds_the_payload(tmp_path: Path) -> None:
     assert np.all(G_error <= 0.05 * np.sqrt(np.mean(G_real**2, axis=0))[1:]), G_error
     np.testing.assert_allclose(found.coulomb, truth["coulomb_n_m"], rtol=0.10)
     error = touch_dob(config, {"urdf_path": str(urdf)})
-    plant_truth = {
-        "urdf.payload_kg": truth["payload_kg"],
-        "urdf.viscous_n_m_s_per_rad": truth["viscous_n_m_s_per_rad"],
-        "urdf.coulomb_n_m": truth["coulomb_n_m"],
-        "urdf.coulomb_speed_rad_per_s": list(truth["coulomb_speed_rad_per_s"]),
-    }
+    plant_truth = truth_model(truth)
     best = touch_dob(config, plant_truth)
     assert error <= 1.05 * best, (error, best)
     pytest.xfail(
@@ -171,3 +179,16 @@ def test_touch_chain_finds_the_payload(tmp_path: Path) -> None:
         f"{truth['viscous_n_m_s_per_rad']} N m s/rad, the estimate within {100 * error:.1f} % "
         f"({100 * best:.1f} % on the plant's truth: the encoder's counts at 500 Hz)"
     )
+
+
+def test_touch_estimate_within_5_percent_with_finer_encoder_counts() -> None:
+    """What limits the Touch's estimate to 7 % is its encoder: the same DOB session, on the
+    plant's truth, with counts ten times finer (4e-5 rad; the Touch's are about 4e-4, its tip's
+    0.055 mm) is within issue 31's 5 % of the true force's span. A model error or the bridge's
+    timing would keep it above (measured 7.05 % at the Touch's counts)."""
+    truth = plants.touch(500.0, 0, {"behaviour": "none"}, (0.0, 0.0, -1.0)).truth()
+    plant_truth = truth_model(truth)
+    fine = truth["encoder_resolution_rad"] / 10.0
+    assert fine == pytest.approx(4e-5)
+    error = touch_dob(CONFIG / "bridge_touch.yaml", plant_truth, fine)
+    assert error <= 0.05, error
