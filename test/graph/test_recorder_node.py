@@ -253,3 +253,42 @@ def test_duration_stops_and_prints_the_counts(tmp_path: Path) -> None:
     assert lines[1].split()[:5] == ["/joint_states", "sensor_msgs/msg/JointState", "0", "0", "0"]
     assert lines[-1] == f"bag: {tmp_path / 'bag'} (sqlite3)"
     assert (tmp_path / "bag" / "metadata.yaml").exists()
+
+
+def test_says_a_publisher_lost_mid_stream_when_one_matches_again(context, tmp_path) -> None:
+    """The recorder hears of its topics' publishers from DDS (``matched``): when the only
+    publisher of a topic that was flowing goes and one comes back, the watch counts one
+    rematch (and the node logs the line ``test_recorder_publishers`` checks)."""
+    rec = RecorderNode(
+        context=context,
+        parameter_overrides=[
+            Parameter("output", value=str(tmp_path / "bag")),
+            Parameter("topics", value=["ee_pose"]),
+        ],
+    )
+    ex = SingleThreadedExecutor(context=context)
+    ex.add_node(rec)
+    watch = rec.publisher_watches[0]
+    count = rec.recording.counts.topics[0]
+    pose = wire.pose_stamped("base_link")
+    try:
+        for sent in (5, 10):  # one publisher, then after it went, another
+            src = rclpy.create_node("environment_node", context=context)
+            pub = RawPublisher(src, SESSION_TOPICS[EE_POSE], EE_POSE, qos.LOOP)
+            ex.add_node(src)
+            assert wait_until(lambda: watch.matched == 1, 10.0, step=spin(ex)), "no match"
+            first = count.received
+            for k in range(first, sent):
+                pose.header.stamp.nanosec = k * 1_000_000
+                pub.publish(pose)
+            assert wait_until(lambda n=sent: count.received == n, 10.0, step=spin(ex))
+            ex.remove_node(src)
+            src.destroy_node()
+            if sent == 5:
+                assert wait_until(lambda: watch.lost_at_s is not None, 10.0, step=spin(ex))
+                assert watch.rematches == 0
+    finally:
+        ex.shutdown()
+        rec.close()
+        rec.destroy_node()
+    assert watch.rematches == 1

@@ -39,8 +39,10 @@ from std_msgs.msg import Header
 
 from haptic_dob.bag.jazzy import offered_qos
 from haptic_dob.nodes.common import main_for
+from haptic_dob.nodes.recorder_events import publisher_events
 from haptic_dob.recorder.drain import take_until_quiet
 from haptic_dob.recorder.matching import ReaderMatch, reported_progress
+from haptic_dob.recorder.publishers import PublisherWatch
 from haptic_dob.recorder.recording import Recording
 from haptic_dob.recorder.settings import new_bag_path, progress_topic, recorder_specs
 from haptic_dob.recorder.snapshots import ParameterSnapshot, SnapshotTracker
@@ -90,12 +92,17 @@ class RecorderNode(LoopNode):
         )
         self._t_end = time.monotonic() + v["duration_s"] if v["duration_s"] > 0 else None
         self._subs: list[tuple[Any, Callable[[bytes], None]]] = []
+        self.publisher_watches: list[PublisherWatch] = []  # per topic, in order
         kinds = [t.kind(self.resolve_topic_name(t.name)) for t in topics]
         for t, kind in zip(topics, kinds, strict=True):
             loop = kind is TopicKind.SESSION
             cb = self.recording.add_topic(self.resolve_topic_name(t.name), t.typename, loop)
+            watch, events = publisher_events(self.recording.counts.topics[-1], self.log.warning)
+            self.publisher_watches.append(watch)
             profile = SUBSCRIPTION_QOS[kind]
-            sub = self.create_subscription(classes[t.typename], t.name, cb, profile, raw=True)
+            sub = self.create_subscription(
+                classes[t.typename], t.name, cb, profile, raw=True, event_callbacks=events
+            )
             self._subs.append((sub, cb))
         if v["log_time"] == "session" and TopicKind.SESSION not in kinds:  # no loop stamps
             self.create_subscription(Clock, CLOCK, self._on_clock, qos.CLOCK)
