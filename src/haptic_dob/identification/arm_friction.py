@@ -149,10 +149,12 @@ def identify_arm_friction(
 def _unexplained(
     rigid: PinocchioModel, f: MotionFilters, position: Arr, effort: Arr
 ) -> tuple[Arr, Arr]:
-    """The effort the rigid body leaves unexplained and the velocity, both through ``f``."""
-    x, v, a = f.motion(position)
+    """The effort the rigid body leaves unexplained and the velocity, both through ``f``: the
+    rigid body's effort on the light motion, filtered like the effort (``filters``' notes)."""
+    x, v, a = f.light_motion(position)
     rigid_effort = np.array([rigid.inverse_dynamics(x[k], v[k], a[k]) for k in range(len(x))])
-    return f.effort(effort) - rigid_effort, v
+    _, v_f, _ = f.motion(position)
+    return f.effort(effort) - f.smooth(rigid_effort), v_f
 
 
 def turn_filters(dt: float, cutoff_hz: float, turn_cutoff_hz: float) -> MotionFilters:

@@ -2,7 +2,9 @@
 
 ROS-free. The URDF gives the kinematics and CAD values, the record joint positions and applied
 efforts (positions differentiated through ``filters``). Effort = ``W theta`` (``arm_parameters``):
-1. the regressor on the first ``1 - holdout`` of the record (filters' ends out, decimated);
+1. the regressor on the first ``1 - holdout`` of the record (filters' ends out, decimated), on
+   the light motion and filtered like the effort (``filters``: the rigid body is nonlinear in
+   the motion);
 2. each base parameter's visibility: one below ``min_visibility`` is refused, named;
 3. least squares (Coulomb a filtered sign), each joint's ``v_c`` (``arm_friction.turn_speed``),
    least squares again, then weighted by each joint's residual RMS (``arm_normal``);
@@ -82,7 +84,7 @@ def identify_arm_model(
     f = MotionFilters.design(dt, cutoff_hz)
     wide = f if turn_cutoff_hz is None else turn_filters(dt, cutoff_hz, turn_cutoff_hz)
     position = np.unwrap(record.position, axis=0)
-    x, v, a = f.motion(position)
+    x, _, _ = f.motion(position)
     tau = f.effort(record.effort)
     v_light = f.light_velocity(position)
     split = int((1.0 - holdout) * n)
@@ -91,7 +93,9 @@ def identify_arm_model(
     if len(held) < 10 or len(idx) * dof < 3 * lay.size:
         raise IdentificationError(f"too short: {len(idx)} samples to fit, {len(held)} held out")
     sign = f.coulomb_term(v_light)
-    W = ap.regressor(cad, x[idx], v[idx], a[idx], sign[idx])
+    light = light_regressor(cad, f, position)
+    W_all = f.smooth(light).reshape(n, dof, -1)
+    W = ap.with_coulomb(W_all[idx].reshape(len(idx) * dof, -1), sign[idx])
     y = tau[idx].ravel()
     W_ref = ap.regressor(cad, *ap.reference_states(cad, ap.REFERENCE_STATES))
     bs = ap.base_set(W_ref)
@@ -110,7 +114,7 @@ def identify_arm_model(
         )
     beta, _, _ = solve(G, b, yy, len(y), bs.base, "the arm")
     speeds = _turn_speeds(
-        cad, (f, wide), (position, record.effort, v_light), (W, y, idx, split), bs, beta, lay
+        (f, wide), (position, record.effort, v_light, light), (W, y, idx, split), bs, beta, lay
     )
     coulomb = np.column_stack([coulomb_term(f, v_light[:, j], c) for j, c in enumerate(speeds)])
     W = ap.with_coulomb(W, coulomb[idx])
@@ -129,7 +133,7 @@ def identify_arm_model(
     R, z = square_root(Gw, bw)
     found = fit_consistent(R, z, sigma, links, (cad_joint, scale, start))
     _check(lay.links, links, found)
-    W_held = ap.regressor(cad, x[held], v[held], a[held], coulomb[held])
+    W_held = ap.with_coulomb(W_all[held].reshape(len(held) * dof, -1), coulomb[held])
     cad_theta = np.concatenate([body_parameters(cad).ravel(), cad_joint])
     pred = (W_held @ found.theta).reshape(len(held), dof)
     pred_cad = (ap.with_coulomb(W_held, sign[held]) @ cad_theta).reshape(len(held), dof)
@@ -147,20 +151,27 @@ def identify_arm_model(
     )
 
 
+def light_regressor(cad: UrdfModel, f: MotionFilters, position: Arr) -> Arr:
+    """The regressor (Coulomb columns zero) of every sample on ``f``'s light motion, one row
+    per sample (N, dof * parameters): ``f.smooth`` of it is the filtered regressor."""
+    n, dof = position.shape
+    x, v, a = f.light_motion(position)
+    return ap.regressor(cad, x, v, a, np.zeros((n, dof))).reshape(n, -1)
+
+
 def _turn_speeds(
-    cad: UrdfModel,
     filters: tuple[MotionFilters, MotionFilters],
-    raw: tuple[Arr, Arr, Arr],
+    raw: tuple[Arr, Arr, Arr, Arr],
     fitted: tuple[Arr, Arr, NDArray[np.intp], int],
     bs: ap.BaseSet,
     beta: Arr,
     lay: ap.Layout,
 ) -> list[float]:
     """Each joint's ``v_c`` (``arm_friction.turn_speed``) on the effort the fitted rigid body and
-    armature leave; ``raw``: positions, efforts, light velocity; ``fitted``: W, y, samples and
-    the held-out part's start."""
+    armature leave; ``raw``: positions, efforts, light velocity, the light motion's regressor
+    (``light_regressor``); ``fitted``: W, y, samples and the held-out part's start."""
     f, wide = filters
-    position, effort, v_light = raw
+    position, effort, v_light, light = raw
     W, y, idx, split = fitted
     n, dof = position.shape
     rigid = np.zeros(lay.size)  # the fitted rigid body and armature, no friction
@@ -172,9 +183,9 @@ def _turn_speeds(
     if wide is f:
         v_w, r_w, idx_w = v, r, idx
     else:
-        x_w, v_w, a_w = wide.motion(position)
+        _, v_w, _ = wide.motion(position)
         idx_w = np.arange(2 * wide.window, split, wide.step)
-        W_w = ap.regressor(cad, x_w[idx_w], v_w[idx_w], a_w[idx_w], np.zeros((len(idx_w), dof)))
+        W_w = wide.smooth(light)[idx_w].reshape(len(idx_w) * dof, -1)
         r_w = np.zeros((n, dof))
         r_w[idx_w] = wide.effort(effort)[idx_w] - (W_w @ rigid).reshape(-1, dof)
     return [

@@ -4,7 +4,12 @@ joint friction): one record's samples in, filtered terms of the equation of moti
 Positions are low-passed by a zero-phase Butterworth filter and differentiated by Savitzky-Golay;
 the effort of sample k, applied over [k-1, k), is centred on the sample like the central
 derivatives and filtered the same way; the Coulomb term is the filtered sign of a lightly
-smoothed velocity. The same linear filters on every term make their lag and gain cancel. Samples
+smoothed velocity. The same linear filters on every term make their lag and gain cancel; a term
+nonlinear in the motion (an arm's rigid body: ``D(q) q''``, Coriolis, gravity) is computed on a
+lightly smoothed motion (``light_motion``) and filtered after, like the effort: the low-pass
+commutes with linear terms only, and the rigid body on the low-passed motion is not the
+low-passed rigid body where the motion has content near the cutoff (the kink Coulomb friction
+puts in the velocity at every reversal, which biased an arm's viscous friction up). Samples
 at rest are left out (stiction is in no model), as are the filters' transients at both ends and
 around a gap in the stamps (``contiguous``: states lost), and the rest is decimated to about
 independent residuals so that standard errors mean something.
@@ -22,6 +27,11 @@ from numpy.typing import NDArray
 from scipy import signal
 
 Arr = NDArray[np.float64]
+
+
+#: the window (samples) of ``MotionFilters.light_motion``: as short as a quadratic fit's that
+#: smooths the acceleration at all, so that the motion a nonlinear term sees is the true one
+LIGHT_MOTION_WINDOW = 5
 
 
 class IdentificationError(ValueError):
@@ -64,6 +74,17 @@ class MotionFilters:
         mid = effort.copy()
         mid[:-1] = 0.5 * (effort[:-1] + effort[1:])
         return self.smooth(mid)
+
+    def light_motion(self, position: Arr) -> tuple[Arr, Arr, Arr]:
+        """A lightly smoothed position, velocity and acceleration (a quadratic Savitzky-Golay
+        over ``LIGHT_MOTION_WINDOW`` samples): what a term nonlinear in the motion is computed
+        on before ``smooth`` filters it like the effort (the noise its derivatives carry the
+        low-pass takes out after)."""
+        w, dt = LIGHT_MOTION_WINDOW, self.dt
+        x = signal.savgol_filter(position, w, 2, axis=0)
+        v = signal.savgol_filter(position, w, 2, deriv=1, delta=dt, axis=0)
+        a = signal.savgol_filter(position, w, 2, deriv=2, delta=dt, axis=0)
+        return np.asarray(x), np.asarray(v), np.asarray(a)
 
     def light_velocity(self, position: Arr) -> Arr:
         """A lightly smoothed velocity: its sign is the Coulomb term's, its size says moving."""
