@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import os
 import random
+import signal
 import statistics
 import subprocess
 import sys
@@ -74,6 +75,19 @@ def driver_prefix() -> list[str]:
     return [*cpus_prefix(), "chrt", "-f", GRAPH_ARGS[GRAPH_ARGS.index("--rt-priority") + 1]]
 
 
+def stop_group(proc: subprocess.Popen[bytes]) -> None:
+    """Stop ``proc``'s process group if ``proc`` still runs (a run that timed out or failed):
+    SIGINT, as a user's Ctrl-C, then SIGKILL after ``haptic-launch``'s stop timeout."""
+    if proc.poll() is not None:
+        return
+    os.killpg(proc.pid, signal.SIGINT)
+    try:
+        proc.wait(timeout=15.0)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+
+
 def one_run(profile: str) -> dict[str, float]:
     """One session of ``profile``: the driver's counts, the bridge's, and the raw hops."""
     config, driver, bridge_name, extra = PROFILES[profile]
@@ -89,13 +103,20 @@ def one_run(profile: str) -> dict[str, float]:
         argv += [*extra, "--set", f"{bridge_name}:duration_s={RUN_S}"]
         argv += ["--set", f"{bridge_name}:stats_file={d / 'bridge.json'}"]
         argv += [a for a in GRAPH_ARGS if a != "--pin"]  # one process: nothing to pin
-        graph = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        graph = subprocess.Popen(
+            argv,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,  # its own group: a run that hangs is stopped whole
+        )
         try:
             if controls is not None:
                 time.sleep(3.0)  # the bridge is up: the user holds the stylus's button
                 controls.press(True)
             out, _ = graph.communicate(timeout=RUN_S + 120)
         finally:
+            stop_group(graph)
             if controls is not None:
                 controls.close()
             drv.stop()

@@ -1,7 +1,7 @@
 """The launch's processes at run time: the scheduling and wake-up latency they start with, then
 start, watch (a failed node stops the graph, and so does the end of the run once every device
-finished its own), forward Ctrl-C and SIGTERM, and stop them all (the device's first), killing
-what outlives the stop timeout."""
+finished its own; one that runs until stopped is not waited for), forward Ctrl-C and SIGTERM,
+and stop them all (the device's first), killing what outlives the stop timeout."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Collection
 
 from haptic_dob.errors import InputError
 from haptic_dob.launcher.process_plan import ProcessSpec
@@ -50,11 +51,13 @@ def launch(
     stop_timeout: float,
     duration: float | None,
     env: dict[str, str] | None = None,
+    endless: Collection[str] = (),
 ) -> int:
     """Start the processes, supervise them, forward signals, stop them all cleanly.
 
     Returns the exit code: 0 for a stop asked for (a signal, ``duration`` s, the device's
-    finished run), 1 when a process ended by itself otherwise.
+    finished run), 1 when a process ended by itself otherwise. ``endless``: device or bridge
+    nodes that run until stopped (``duration_s`` 0), whose processes no finished run waits for.
     """
     stop: list[int] = []
 
@@ -65,7 +68,11 @@ def launch(
     procs: dict[str, subprocess.Popen[bytes]] = {}
     labels = {s.name: s.label for s in specs}
     ends = ("device_node", "bridge_node")  # a device's lockstep run, a bridge's duration_s
-    devices = {s.name for s in specs if any(n.rsplit("/", 1)[-1] in ends for n in s.nodes)}
+    devices = {
+        s.name
+        for s in specs
+        if any(n.rsplit("/", 1)[-1] in ends and n not in endless for n in s.nodes)
+    }
     code = 0
     try:
         for spec in specs:

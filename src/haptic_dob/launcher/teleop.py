@@ -163,6 +163,18 @@ def teleop_groups(
     return groups
 
 
+def endless_devices(params: Mapping[str, Mapping[str, Any]]) -> set[str]:
+    """The devices and bridges that run until stopped (``duration_s`` 0): a side's process that
+    holds one never ends the graph, so the other side's finished run does (with ``--group``
+    as in one process)."""
+    ends = ("device_node", "bridge_node")
+    return {
+        name
+        for name, values in params.items()
+        if name.rsplit("/", 1)[-1] in ends and float(values.get("duration_s", -1.0)) == 0.0
+    }
+
+
 def teleop_plan(
     params: Mapping[str, Any], params_file: Path, groups: Sequence[Sequence[str]]
 ) -> list[ProcessSpec]:
@@ -228,4 +240,4 @@ def teleop_command(opts: LaunchOptions, sections: Mapping[str, Mapping[str, Any]
         for spec in specs:
             if len(spec.nodes) > 1:
                 print(f"haptic-launch: {spec.name} in one process", file=sys.stderr)
-        return launch(specs, opts.stop_timeout, opts.duration, net)
+        return launch(specs, opts.stop_timeout, opts.duration, net, endless_devices(params))

@@ -4,14 +4,20 @@ single loop's launch has that a teleoperation graph refuses."""
 
 from __future__ import annotations
 
+import sys
+import time
+
 import pytest
 import yaml
 
 from haptic_dob.errors import InputError
 from haptic_dob.launcher.node_params import add_command_tokens
 from haptic_dob.launcher.options import LaunchOptions
+from haptic_dob.launcher.process_plan import ProcessSpec
+from haptic_dob.launcher.supervise import launch
 from haptic_dob.launcher.teleop import (
     add_teleop_recorder,
+    endless_devices,
     select_nodes,
     teleop_command,
     teleop_groups,
@@ -168,3 +174,22 @@ def test_record_adds_a_recorder_of_both_sides_apart_that_both_devices_wait_for(
 def test_single_loop_options_are_refused(sections, option, flag) -> None:
     with pytest.raises(InputError, match=f"{flag}: not for a teleoperation graph"):
         teleop_command(LaunchOptions(config="teleop_sim", **option), sections)
+
+
+def test_a_side_that_runs_until_stopped_does_not_hold_the_others_finished_run(
+    sections,
+) -> None:
+    """``--group master --group slave`` with the master's device running until stopped
+    (``duration_s`` 0) and the slave's ending its run: the slave's end stops the graph, as in
+    one process (its container stops when every node that ends a run has)."""
+    params = teleop_params(sections, ["master/device_node:duration_s=0"])
+    assert endless_devices(params) == {"master/device_node"}
+    forever = [sys.executable, "-c", "import time; time.sleep(120)"]
+    ends = [sys.executable, "-c", "import time; time.sleep(0.5)"]
+    specs = [
+        ProcessSpec("master", ["master/device_node"], forever[0], forever[1:]),
+        ProcessSpec("slave", ["slave/device_node"], ends[0], ends[1:]),
+    ]
+    t0 = time.monotonic()  # --duration 30 bounds a launch that would wait for the master
+    assert launch(specs, 5.0, 30.0, endless=endless_devices(params)) == 0
+    assert time.monotonic() - t0 < 20.0  # the slave's end stopped it, not the duration
