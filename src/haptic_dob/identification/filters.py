@@ -5,17 +5,13 @@ Positions are low-passed by a zero-phase Butterworth filter and differentiated b
 the effort of sample k, applied over [k-1, k), is centred on the sample like the central
 derivatives and filtered the same way; the Coulomb term is the filtered sign of a lightly
 smoothed velocity. The same linear filters on every term make their lag and gain cancel; a term
-nonlinear in the motion (an arm's rigid body: ``D(q) q''``, Coriolis, gravity) is computed on a
-lightly smoothed motion (``light_motion``) and filtered after, like the effort: the low-pass
-commutes with linear terms only, and the rigid body on the low-passed motion is not the
-low-passed rigid body where the motion has content near the cutoff (the kink Coulomb friction
-puts in the velocity at every reversal, which biased an arm's viscous friction up). Samples
-at rest are left out (stiction is in no model), as are the filters' transients at both ends and
-around a gap in the stamps (``contiguous``: states lost), and the rest is decimated to about
-independent residuals so that standard errors mean something.
-Arrays are along axis 0 (one column per joint for an arm).
+nonlinear in the motion (an arm's rigid body) is computed on a lightly smoothed motion
+(``light_motion``) and filtered after, like the effort (docs/design/identification.md, "The
+filters"). Samples at rest are left out (stiction is in no model), as are the filters' transients
+at both ends and around a gap in the stamps (``contiguous``: states lost), and the rest is
+decimated to about independent residuals so that standard errors mean something. Arrays are
+along axis 0 (one column per joint for an arm).
 """
-
 from __future__ import annotations
 
 import math
