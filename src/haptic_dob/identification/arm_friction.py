@@ -3,15 +3,14 @@
 
 ROS-free (numpy/scipy/the model's pinocchio). The rigid-body part comes from the arm's model (its
 URDF's masses and inertias, friction left out); what the measured effort has beyond it is fitted
-per joint as viscous plus Coulomb friction by least squares, with the 1-DOF identification's
-filters (``haptic_dob.identification.filters``). ``v_c`` is searched over a grid (``b`` and
-``Fc`` by least squares at each, the smallest residual wins, refined by scipy's bounded scalar
-search), on every sample but the filters' ends, slow ones included: reversals are where it
-shows. The search may judge each candidate through a wider low-pass (``turn_cutoff_hz``) than
-the fit's (``cutoff_hz``); why: docs/recording-and-analysis.md, "Identifying the device model".
-
-The fit uses the first ``1 - holdout`` of the record; on the rest each joint reports the RMS of
-what the rigid-body model leaves unexplained without and with the fitted friction.
+per joint as viscous plus Coulomb friction with the 1-DOF identification's filters
+(``haptic_dob.identification.filters``). ``v_c`` is searched over a grid (``b`` and ``Fc`` by
+least squares at each, the smallest residual wins, refined by scipy's bounded scalar search) on
+every sample but the filters' ends, slow ones included (reversals are where it shows), possibly
+through a wider low-pass (``turn_cutoff_hz``); then ``b`` and ``Fc`` where the joint moves
+clear of its turns (``MotionFilters.clear_of_turns``). Why: docs/recording-and-analysis.md,
+"Identifying the device model". The fit uses the first ``1 - holdout`` of the record; on the
+rest each joint reports the RMS the rigid body leaves unexplained without and with the friction.
 """
 
 from __future__ import annotations
@@ -25,7 +24,14 @@ from numpy.typing import NDArray
 from scipy.optimize import minimize_scalar
 
 from haptic_dob.core.models._pinocchio import PinocchioModel
-from haptic_dob.identification.filters import IdentificationError, MotionFilters, fit, physical
+from haptic_dob.identification.filters import (
+    MIN_CLEAR,
+    MIN_SPEED,
+    IdentificationError,
+    MotionFilters,
+    fit,
+    physical,
+)
 
 Arr = NDArray[np.float64]
 
@@ -73,7 +79,7 @@ def identify_arm_friction(
     effort: Arr,
     names: Sequence[str],
     cutoff_hz: float = 20.0,
-    min_speed: float = 0.02,
+    min_speed: float = MIN_SPEED,
     holdout: float = 0.3,
     turn_cutoff_hz: float | None = None,
 ) -> ArmFrictionFit:
@@ -127,7 +133,9 @@ def identify_arm_friction(
             str(name),
         )
         s = coulomb_term(f, v_light[:, j], c)
-        theta, std, _ = fit(np.column_stack([v[every, j], s[every]]), r[every, j], str(name))
+        clear = every[f.clear_of_turns(v_light[:, j], c, min_speed)[every]]
+        rows = clear if len(clear) >= MIN_CLEAR else every  # b and Fc where the term is flat
+        theta, std, _ = fit(np.column_stack([v[rows, j], s[rows]]), r[rows, j], str(name))
         rt = r[test_idx, j]
         pred = np.column_stack([v[test_idx, j], s[test_idx]]) @ theta
         out.append(
@@ -137,7 +145,7 @@ def identify_arm_friction(
                 physical("Coulomb friction", float(theta[1]), float(std[1]), str(name)),
                 float(std[0]),
                 float(std[1]),
-                len(every),
+                len(rows),
                 math.sqrt(float(np.mean(rt * rt))),
                 math.sqrt(float(np.mean((rt - pred) ** 2))),
                 float(c),

@@ -3,11 +3,11 @@
 ROS-free. The URDF gives the kinematics and CAD values, the record joint positions and applied
 efforts (positions differentiated through ``filters``). Effort = ``W theta`` (``arm_parameters``):
 1. the regressor on the first ``1 - holdout`` of the record (filters' ends out, decimated), on
-   the light motion and filtered like the effort (``filters``: the rigid body is nonlinear in
-   the motion);
+   the light motion and filtered like the effort (``filters``: nonlinear in the motion);
 2. each base parameter's visibility: one below ``min_visibility`` is refused, named;
 3. least squares (Coulomb a filtered sign), each joint's ``v_c`` (``arm_friction.turn_speed``),
-   least squares again, then weighted by each joint's residual RMS (``arm_normal``);
+   least squares again on each joint's rows clear of its turns (``clear_rows``), then
+   weighted by each joint's residual RMS (``arm_normal``);
 4. a physically consistent full set (``arm_consistent``) drawn toward CAD, checked: mass > 0,
    centre of mass in the link's box (the origins its link carries and the CAD inertia's
    equivalent box, plus ``margin_m``), pseudo-inertia positive definite;
@@ -36,7 +36,12 @@ from haptic_dob.identification.arm_friction import coulomb_term, turn_filters, t
 from haptic_dob.identification.arm_model_report import ArmModelFit, JointFit, LinkFit
 from haptic_dob.identification.arm_normal import Normal, condition_number, solve, square_root
 from haptic_dob.identification.arm_urdf import LinkInertial, link_inertials
-from haptic_dob.identification.filters import IdentificationError, MotionFilters
+from haptic_dob.identification.filters import (
+    MIN_CLEAR,
+    MIN_SPEED,
+    IdentificationError,
+    MotionFilters,
+)
 
 Arr = NDArray[np.float64]
 #: a base parameter the record determines with more than 1 / this the variance per sample that
@@ -118,11 +123,11 @@ def identify_arm_model(
     )
     coulomb = np.column_stack([coulomb_term(f, v_light[:, j], c) for j, c in enumerate(speeds)])
     W = ap.with_coulomb(W, coulomb[idx])
-    normal = Normal.of(W, y, dof)
-    beta, _, _ = solve(*normal.total(), len(y), bs.base, "the arm")
+    normal = Normal.of(W, y, dof, clear_rows(f, v_light, speeds, idx))
+    beta, _, _ = solve(*normal.total(), normal.rows, bs.base, "the arm")
     weight = 1.0 / np.maximum(normal.residual_rms(bs.base, beta), 1e-12)  # each joint's rows
     Gw, bw, yyw = normal.total(weight)
-    beta, std, sigma = solve(Gw, bw, yyw, len(y), bs.base, "the arm")
+    beta, std, sigma = solve(Gw, bw, yyw, normal.rows, bs.base, "the arm")
     inertials = link_inertials(urdf)
     links = [_link(b, inertials, margin_m) for b in bodies(cad)]
     cad_joint = np.concatenate([cad.armature, cad.viscous, cad.coulomb])
@@ -149,6 +154,19 @@ def identify_arm_model(
         visibility=tuple((nm, float(v_)) for nm, v_ in zip(names, seen, strict=True)),
         unidentifiable=tuple(lay.names[i] for i in bs.dependent),
     )
+
+
+def clear_rows(
+    f: MotionFilters, v_light: Arr, speeds: Sequence[float], idx: NDArray[np.intp]
+) -> NDArray[np.bool_]:
+    """Each joint's rows (samples ``idx``) where it moves clear of its Coulomb term's turns
+    (``MotionFilters.clear_of_turns``), or all of them where fewer than ``MIN_CLEAR`` are."""
+    keep = np.ones((len(idx), len(speeds)), dtype=bool)
+    for j, c in enumerate(speeds):
+        clear = f.clear_of_turns(v_light[:, j], c, MIN_SPEED)[idx]
+        if clear.sum() >= MIN_CLEAR:
+            keep[:, j] = clear
+    return keep
 
 
 def light_regressor(cad: UrdfModel, f: MotionFilters, position: Arr) -> Arr:

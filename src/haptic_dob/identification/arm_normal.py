@@ -24,20 +24,32 @@ Cols = NDArray[np.intp]
 
 @dataclass(frozen=True)
 class Normal:
-    """Per joint: ``G`` (dof, p, p), ``b`` (dof, p), ``yy`` (dof,); ``samples`` N."""
+    """Per joint: ``G`` (dof, p, p), ``b`` (dof, p), ``yy`` (dof,); ``samples`` N, of which
+    ``counts`` (dof,) are each joint's rows taken."""
 
     G: Arr
     b: Arr
     yy: Arr
     samples: int
+    counts: Arr
 
     @classmethod
-    def of(cls, W: Arr, y: Arr, dof: int) -> Normal:
-        """From the rows (sample by sample, ``dof`` rows each)."""
+    def of(cls, W: Arr, y: Arr, dof: int, keep: NDArray[np.bool_] | None = None) -> Normal:
+        """From the rows (sample by sample, ``dof`` rows each); ``keep`` (N, dof): the rows
+        taken (default all)."""
         n = len(y) // dof
         W3, y2 = W.reshape(n, dof, -1), y.reshape(n, dof)
+        if keep is not None:
+            W3, y2 = W3 * keep[:, :, None], y2 * keep
+        counts = np.full(dof, float(n)) if keep is None else keep.sum(axis=0).astype(float)
         G = np.einsum("kjp,kjq->jpq", W3, W3)
-        return cls(G, np.einsum("kjp,kj->jp", W3, y2), np.einsum("kj,kj->j", y2, y2), n)
+        b, yy = np.einsum("kjp,kj->jp", W3, y2), np.einsum("kj,kj->j", y2, y2)
+        return cls(G, b, yy, n, counts)
+
+    @property
+    def rows(self) -> int:
+        """Rows taken, over every joint."""
+        return int(self.counts.sum())
 
     def total(self, weight: Arr | None = None) -> tuple[Arr, Arr, float]:
         """``W^T W``, ``W^T y``, ``y^T y`` with joint j's rows times ``weight[j]`` (default 1)."""
@@ -49,7 +61,7 @@ class Normal:
         """Each joint's RMS of ``y - W[:, cols] theta``."""
         G = self.G[:, cols][:, :, cols]
         rss = self.yy - 2.0 * self.b[:, cols] @ theta + np.einsum("p,jpq,q->j", theta, G, theta)
-        out: Arr = np.sqrt(np.maximum(rss, 0.0) / self.samples)
+        out: Arr = np.sqrt(np.maximum(rss, 0.0) / np.maximum(self.counts, 1.0))
         return out
 
 

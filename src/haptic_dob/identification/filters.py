@@ -12,6 +12,7 @@ at both ends and around a gap in the stamps (``contiguous``: states lost), and t
 decimated to about independent residuals so that standard errors mean something. Arrays are
 along axis 0 (one column per joint for an arm).
 """
+
 from __future__ import annotations
 
 import math
@@ -24,6 +25,15 @@ from scipy import signal
 
 Arr = NDArray[np.float64]
 
+
+#: friction is fitted where a joint moves faster than this many times its Coulomb term's turning
+#: speed all through the filters' support: ``tanh(5) = 0.9999``, the term flat, so the late turn
+#: of a filtered velocity at a reversal is out of the fit (``MotionFilters.clear_of_turns``)
+FLAT_TURNS = 5.0
+#: fewest samples (decimated) for a joint's friction fit clear of its turns; fewer: every sample
+MIN_CLEAR = 40
+#: rad/s (or m/s): slower is at rest for the friction fits (stiction is in no model)
+MIN_SPEED = 0.02
 
 #: the window (samples) of ``MotionFilters.light_motion``: as short as a quadratic fit's that
 #: smooths the acceleration at all, so that the motion a nonlinear term sees is the true one
@@ -98,6 +108,13 @@ class MotionFilters:
         keep[:edge] = False
         keep[len(keep) - edge :] = False
         return np.asarray(keep)
+
+    def clear_of_turns(
+        self, light_velocity: Arr, speed: float, min_speed: float
+    ) -> NDArray[np.bool_]:
+        """Samples moving faster than ``FLAT_TURNS`` times the Coulomb term's turning ``speed``
+        (and ``min_speed``) all through the filter: where that term is flat (``usable``)."""
+        return self.usable(light_velocity, max(min_speed, FLAT_TURNS * speed))
 
     def contiguous(self, stamps_ns: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Samples whose filters' support holds no gap in the stamps (a step of more than 1.5

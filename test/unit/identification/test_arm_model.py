@@ -61,9 +61,9 @@ def test_a_short_bag_gives_a_consistent_model_whose_observer_reads_free_motion_r
     config, record
 ) -> None:
     """15 s (1.5 periods): the held-out residual falls from CAD's 85 % of the worst joint's
-    torque span to 0.86 % (measured); each joint's friction within 3 % of the truth's, its
+    torque span to 0.99 % (measured); each joint's friction within 0.05 % of the truth's, its
     armature within 3 % (measured); every link consistent; an observer on the model reads free
-    motion under 0.2 N (measured 0.035 N; CAD 6 N) and a held 5 N within 3 % (0.06 %)."""
+    motion under 0.2 N (measured 0.046 N; CAD 6 N) and a held 5 N within 3 % (0.005 %)."""
     fit = identify_slave(config, record)
     assert fit.residual_pct < 3.0 < 10.0 < fit.residual_cad_pct, fit.residual_pct
     truth = slave_bench(config).truth
