@@ -25,7 +25,6 @@ from scipy.optimize import minimize_scalar
 
 from haptic_dob.core.models._pinocchio import PinocchioModel
 from haptic_dob.identification.filters import (
-    MIN_CLEAR,
     MIN_SPEED,
     IdentificationError,
     MotionFilters,
@@ -133,8 +132,7 @@ def identify_arm_friction(
             str(name),
         )
         s = coulomb_term(f, v_light[:, j], c)
-        clear = every[f.clear_of_turns(v_light[:, j], c, min_speed)[every]]
-        rows = clear if len(clear) >= MIN_CLEAR else every  # b and Fc where the term is flat
+        rows = every[f.clear_of_turns(v_light[:, j], c, min_speed, every)]  # the term flat
         theta, std, _ = fit(np.column_stack([v[rows, j], s[rows]]), r[rows, j], str(name))
         rt = r[test_idx, j]
         pred = np.column_stack([v[test_idx, j], s[test_idx]]) @ theta

@@ -37,7 +37,6 @@ from haptic_dob.identification.arm_model_report import ArmModelFit, JointFit, Li
 from haptic_dob.identification.arm_normal import Normal, condition_number, solve, square_root
 from haptic_dob.identification.arm_urdf import LinkInertial, link_inertials
 from haptic_dob.identification.filters import (
-    MIN_CLEAR,
     MIN_SPEED,
     IdentificationError,
     MotionFilters,
@@ -160,13 +159,10 @@ def clear_rows(
     f: MotionFilters, v_light: Arr, speeds: Sequence[float], idx: NDArray[np.intp]
 ) -> NDArray[np.bool_]:
     """Each joint's rows (samples ``idx``) where it moves clear of its Coulomb term's turns
-    (``MotionFilters.clear_of_turns``), or all of them where fewer than ``MIN_CLEAR`` are."""
-    keep = np.ones((len(idx), len(speeds)), dtype=bool)
-    for j, c in enumerate(speeds):
-        clear = f.clear_of_turns(v_light[:, j], c, MIN_SPEED)[idx]
-        if clear.sum() >= MIN_CLEAR:
-            keep[:, j] = clear
-    return keep
+    (``MotionFilters.clear_of_turns``), one column per joint."""
+    return np.column_stack(
+        [f.clear_of_turns(v_light[:, j], c, MIN_SPEED, idx) for j, c in enumerate(speeds)]
+    )
 
 
 def light_regressor(cad: UrdfModel, f: MotionFilters, position: Arr) -> Arr:

@@ -110,11 +110,13 @@ class MotionFilters:
         return np.asarray(keep)
 
     def clear_of_turns(
-        self, light_velocity: Arr, speed: float, min_speed: float
+        self, light_velocity: Arr, speed: float, min_speed: float, rows: NDArray[np.intp]
     ) -> NDArray[np.bool_]:
-        """Samples moving faster than ``FLAT_TURNS`` times the Coulomb term's turning ``speed``
-        (and ``min_speed``) all through the filter: where that term is flat (``usable``)."""
-        return self.usable(light_velocity, max(min_speed, FLAT_TURNS * speed))
+        """Which of ``rows`` (sample indices) move faster than ``FLAT_TURNS`` times the Coulomb
+        term's turning ``speed`` (and ``min_speed``) all through the filter, where that term is
+        flat (``usable``); all of them where fewer than ``MIN_CLEAR`` do."""
+        clear = self.usable(light_velocity, max(min_speed, FLAT_TURNS * speed))[rows]
+        return clear if int(clear.sum()) >= MIN_CLEAR else np.ones(len(rows), dtype=bool)
 
     def contiguous(self, stamps_ns: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Samples whose filters' support holds no gap in the stamps (a step of more than 1.5

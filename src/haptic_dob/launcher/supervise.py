@@ -17,6 +17,8 @@ from haptic_dob.launcher.process_plan import ProcessSpec
 from haptic_dob.runtime.cpu_latency import hold
 
 RT_PRIORITIES = range(1, 100)  # SCHED_FIFO priorities Linux accepts
+#: nodes whose finished run ends the graph: a device's (lockstep) run, a bridge's duration_s
+RUN_ENDS = ("device_node", "bridge_node")
 
 
 def set_rt_priority(priority: int) -> None:
@@ -67,11 +69,10 @@ def launch(
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     procs: dict[str, subprocess.Popen[bytes]] = {}
     labels = {s.name: s.label for s in specs}
-    ends = ("device_node", "bridge_node")  # a device's lockstep run, a bridge's duration_s
     devices = {
         s.name
         for s in specs
-        if any(n.rsplit("/", 1)[-1] in ends and n not in endless for n in s.nodes)
+        if any(n.rsplit("/", 1)[-1] in RUN_ENDS and n not in endless for n in s.nodes)
     }
     code = 0
     try:

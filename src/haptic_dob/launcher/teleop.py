@@ -29,7 +29,7 @@ from haptic_dob.launcher.node_params import add_command_tokens
 from haptic_dob.launcher.options import LaunchOptions, network_env, say_session
 from haptic_dob.launcher.process_plan import ProcessSpec, executable
 from haptic_dob.launcher.robot_description import fetch, fill
-from haptic_dob.launcher.supervise import launch, set_rt_priority
+from haptic_dob.launcher.supervise import RUN_ENDS, launch, set_rt_priority
 from haptic_dob.nodes.registry import CONTAINER, NODES
 from haptic_dob.teleop.graph import (
     NAMESPACES,
@@ -167,11 +167,10 @@ def endless_devices(params: Mapping[str, Mapping[str, Any]]) -> set[str]:
     """The devices and bridges that run until stopped (``duration_s`` 0): a side's process that
     holds one never ends the graph, so the other side's finished run does (with ``--group``
     as in one process)."""
-    ends = ("device_node", "bridge_node")
     return {
         name
         for name, values in params.items()
-        if name.rsplit("/", 1)[-1] in ends and float(values.get("duration_s", -1.0)) == 0.0
+        if name.rsplit("/", 1)[-1] in RUN_ENDS and float(values.get("duration_s", -1.0)) == 0.0
     }
 
 
