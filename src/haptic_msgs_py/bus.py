@@ -29,11 +29,12 @@ Callback = Callable[[Any], None]
 class Topic:
     """One topic's subscribers and publishers in this process."""
 
-    __slots__ = ("listeners", "name", "publishers", "subscribers")
+    __slots__ = ("leading", "listeners", "name", "publishers", "subscribers")
 
     def __init__(self, name: str) -> None:
         self.name = name
         self.subscribers: list[Callback] = []  # shared with the publishers: no copy per publish
+        self.leading = 0  # the first ``leading`` subscribers came with ``first``
         self.publishers: list[Any] = []
         self.listeners: list[Callable[[], None]] = []  # told when the publishers change
 
@@ -82,11 +83,19 @@ class Bus:
         """Every publisher in this process."""
         return [p for t in self.topics.values() for p in t.publishers]
 
-    def add_subscriber(self, name: str, callback: Callback, listener: Callable[[], None]) -> Topic:
+    def add_subscriber(
+        self, name: str, callback: Callback, listener: Callable[[], None], first: bool = False
+    ) -> Topic:
         """``callback`` takes every value published on ``name`` in this process; ``listener`` is
-        called whenever the number of publishers here changes."""
+        called whenever the number of publishers here changes. A ``first`` subscriber (a
+        controller's input) is called before the others, whenever it joined: a command whose
+        inputs are complete goes out before work off its path (docs/design/timing.md)."""
         t = self.topic(name)
-        t.subscribers.append(callback)
+        if first:
+            t.subscribers.insert(t.leading, callback)
+            t.leading += 1
+        else:
+            t.subscribers.append(callback)
         t.listeners.append(listener)
         return t
 

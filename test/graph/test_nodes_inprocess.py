@@ -242,6 +242,38 @@ def test_after_a_switch_the_controller_waits_for_a_lagging_input(context) -> Non
         ctl.destroy_node()
 
 
+def test_composed_the_slaves_command_goes_out_before_its_observer_works(context) -> None:
+    """The teleoperation slave's command does not wait for its observer (whose estimate only
+    goes to the master): composed, command k is out before estimate k is made, though the
+    observer joined the process first (as ``haptic-launch`` composes them)."""
+    from rclpy.node import Node
+
+    from haptic_msgs_py import codecs
+    from haptic_msgs_py.bus import bus_for
+    from haptic_msgs_py.ros import qos
+    from haptic_msgs_py.ros.loop_io import LoopPublisher
+    from haptic_msgs_py.topics import EFFORT_COMMAND, JOINT_STATES, POSE_DESIRED, WRENCH_ESTIMATE
+
+    obs, ctl = ObserverNode(context=context), SlaveControllerNode(context=context)
+    device = Node("device", context=context)
+    log: list[tuple[str, int]] = []
+    bus = bus_for(context)
+    for topic in (EFFORT_COMMAND, WRENCH_ESTIMATE):
+        bus.add_subscriber(f"/{topic}", lambda v, t=topic: log.append((t, v.stamp_ns)), lambda: 0)
+    p_js = LoopPublisher(device, JOINT_STATES, codecs.JOINT_STATE, qos.LOOP, "world")
+    p_target = LoopPublisher(device, POSE_DESIRED, codecs.POSE, qos.LOOP, "world")
+    try:
+        for k in range(1, 4):
+            stamp = k * 1_000_000  # 1 kHz
+            p_target.publish(StampedVector(stamp, (0.001, 0.0, 0.0)))
+            p_js.publish(JointSample(stamp, ("slide",), (0.0,), (0.0,), (0.0,)))
+        stamps = [k * 1_000_000 for k in range(1, 4)]
+        assert log == [x for s in stamps for x in ((EFFORT_COMMAND, s), (WRENCH_ESTIMATE, s))]
+    finally:
+        for n in (device, ctl, obs):
+            n.destroy_node()
+
+
 @pytest.mark.parametrize("wait_for", ["[absent_node]", "[]"])
 def test_a_realtime_device_ticks_only_once_its_graph_is_up(monkeypatch, wait_for: str) -> None:
     """In real time as in lockstep the device waits for ``wait_for`` (and says for what);

@@ -107,8 +107,8 @@ class ControllerNode(LoopNode):
         if self.join.needs_q:
             inputs.append((JOINT_STATES, codecs.JOINT_STATE, self._on_joint_states))
         profile = qos.loop_input(values["input_reliability"])
-        for topic, codec, callback in inputs:
-            LoopSubscription(self, topic, codec, callback, profile)
+        for topic, codec, callback in inputs:  # first: heard before off-path work (timing.md)
+            LoopSubscription(self, topic, codec, callback, profile, first=True)
         self.diagnostics = Diagnostics(self, self._report)
         self.params.set_validator(self._settings, self._apply)
 

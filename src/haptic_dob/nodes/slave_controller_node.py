@@ -77,9 +77,11 @@ class SlaveControllerNode(LoopNode):
         self._token = v["command_token"] or new_token()
         self._pub = LoopPublisher(self, EFFORT_COMMAND, codecs.EFFORT, qos.LOOP)
         inputs = qos.loop_input(v["input_reliability"])
-        LoopSubscription(self, JOINT_STATES, codecs.JOINT_STATE, self._on_joints, inputs)
+        # first: the command goes out before the observer's estimate is made (timing.md)
+        on_joints, on_target = self._on_joints, self._on_target
+        LoopSubscription(self, JOINT_STATES, codecs.JOINT_STATE, on_joints, inputs, first=True)
         if self.controller.trajectory is None:
-            LoopSubscription(self, POSE_DESIRED, codecs.POSE, self._on_target, inputs)
+            LoopSubscription(self, POSE_DESIRED, codecs.POSE, on_target, inputs, first=True)
         self.diagnostics = Diagnostics(self, self._report)
 
     def _on_joints(self, js: JointSample) -> None:

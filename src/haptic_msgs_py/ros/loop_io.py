@@ -97,7 +97,8 @@ class LoopPublisher:
 
 class LoopSubscription:
     """One loop topic's input: ``callback(value)`` from publishers here, or from DDS
-    (``outside(value)`` when given)."""
+    (``outside(value)`` when given). A controller's inputs are ``first``: publishers here call
+    them before the topic's other subscribers (``Bus.add_subscriber``)."""
 
     def __init__(
         self,
@@ -107,6 +108,7 @@ class LoopSubscription:
         callback: Callable[[Any], None],
         qos: QoSProfile,
         outside: Callable[[Any], None] | None = None,
+        first: bool = False,
     ) -> None:
         self.node = node
         self.topic = node.resolve_topic_name(topic)
@@ -119,7 +121,7 @@ class LoopSubscription:
         self.outside = False  # listen on DDS while a publisher is here, too
         self.bus = bus_for(node.context)
         self.bus.join(node.get_fully_qualified_name())
-        self._topic = self.bus.add_subscriber(self.topic, callback, self._follow)
+        self._topic = self.bus.add_subscriber(self.topic, callback, self._follow, first)
         self._follow()
 
     @property

@@ -60,6 +60,19 @@ def test_a_batch_holds_the_sends_until_it_ends() -> None:
     assert log == ["got 2", "send /a 1", "send /b 2"]
 
 
+def test_a_controllers_input_is_heard_first_whenever_it_joined() -> None:
+    """A ``first`` subscriber (a controller's) is called before the others on its topic, in the
+    order the first ones joined, even when an observer joined before it."""
+    bus, log = Bus(), []
+    pub = Pub(bus, "/joint_states", log, readers=False)
+    bus.add_subscriber("/joint_states", lambda v: log.append(f"observer {v}"), lambda: None)
+    bus.add_subscriber("/joint_states", lambda v: log.append(f"controller {v}"), lambda: None, True)
+    bus.add_subscriber("/joint_states", lambda v: log.append(f"recorder {v}"), lambda: None)
+    bus.add_subscriber("/joint_states", lambda v: log.append(f"second {v}"), lambda: None, True)
+    pub.publish(3)
+    assert log == ["controller 3", "second 3", "observer 3", "recorder 3"]
+
+
 def test_work_given_during_a_publish_runs_after_it_and_at_once_outside() -> None:
     bus, log = Bus(), []
     pub = Pub(bus, "/x", log, readers=False)
