@@ -91,7 +91,7 @@ class Bus:
         controller's input) is called before the others, whenever it joined: a command whose
         inputs are complete goes out before work off its path (docs/design/timing.md)."""
         t = self.topic(name)
-        if first:
+        if first:  # nodes are built before the loop spins: never inside a delivery
             t.subscribers.insert(t.leading, callback)
             t.leading += 1
         else:

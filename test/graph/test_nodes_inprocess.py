@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 import rclpy
 from rclpy.context import Context
@@ -242,36 +244,44 @@ def test_after_a_switch_the_controller_waits_for_a_lagging_input(context) -> Non
         ctl.destroy_node()
 
 
-def test_composed_the_slaves_command_goes_out_before_its_observer_works(context) -> None:
-    """The teleoperation slave's command does not wait for its observer (whose estimate only
-    goes to the master): composed, command k is out before estimate k is made, though the
-    observer joined the process first (as ``haptic-launch`` composes them)."""
+def test_composed_in_ol_the_command_goes_out_before_the_observer_works(monkeypatch) -> None:
+    """On a device whose Jacobian depends on q (the Touch's URDF) the controller takes the joint
+    states, and so does the observer, whose estimate OL does not use: composed, command k is out
+    before estimate k is made, though the observer joined the process first (as the registry
+    builds them)."""
     from rclpy.node import Node
 
     from haptic_msgs_py import codecs
     from haptic_msgs_py.bus import bus_for
     from haptic_msgs_py.ros import qos
     from haptic_msgs_py.ros.loop_io import LoopPublisher
-    from haptic_msgs_py.topics import EFFORT_COMMAND, JOINT_STATES, POSE_DESIRED, WRENCH_ESTIMATE
+    from haptic_msgs_py.topics import EFFORT_COMMAND, JOINT_STATES, WRENCH_DESIRED, WRENCH_ESTIMATE
 
-    obs, ctl = ObserverNode(context=context), SlaveControllerNode(context=context)
-    device = Node("device", context=context)
+    monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
+    urdf = Path(__file__).resolve().parents[2] / "config" / "urdf" / "phantom_omni.urdf"
+    ctx = Context()
+    params = ("model:=urdf", f"urdf_path:={urdf}", "tip_frame:=tip", "mode:=OL")
+    rclpy.init(context=ctx, args=["--ros-args", *(x for p in params for x in ("-p", p))])
+    obs, ctl = ObserverNode(context=ctx), ControllerNode(context=ctx)
+    assert ctl.join.needs_q
+    device = Node("device", context=ctx)
     log: list[tuple[str, int]] = []
-    bus = bus_for(context)
+    bus = bus_for(ctx)
     for topic in (EFFORT_COMMAND, WRENCH_ESTIMATE):
         bus.add_subscriber(f"/{topic}", lambda v, t=topic: log.append((t, v.stamp_ns)), lambda: 0)
     p_js = LoopPublisher(device, JOINT_STATES, codecs.JOINT_STATE, qos.LOOP, "world")
-    p_target = LoopPublisher(device, POSE_DESIRED, codecs.POSE, qos.LOOP, "world")
+    p_wall = LoopPublisher(device, WRENCH_DESIRED, codecs.WRENCH, qos.LOOP, "world")
+    names = tuple(obs.model.joint_names)
     try:
-        for k in range(1, 4):
-            stamp = k * 1_000_000  # 1 kHz
-            p_target.publish(StampedVector(stamp, (0.001, 0.0, 0.0)))
-            p_js.publish(JointSample(stamp, ("slide",), (0.0,), (0.0,), (0.0,)))
-        stamps = [k * 1_000_000 for k in range(1, 4)]
+        stamps = [k * ctl.period_ns for k in range(1, 4)]
+        for stamp in stamps:
+            p_wall.publish(StampedVector(stamp, (0.0, 0.0, 0.5)))
+            p_js.publish(JointSample(stamp, names, (0.0, 0.3, 0.2), (0.0,) * 3, (0.0,) * 3))
         assert log == [x for s in stamps for x in ((EFFORT_COMMAND, s), (WRENCH_ESTIMATE, s))]
     finally:
         for n in (device, ctl, obs):
             n.destroy_node()
+        rclpy.try_shutdown(context=ctx)
 
 
 @pytest.mark.parametrize("wait_for", ["[absent_node]", "[]"])
