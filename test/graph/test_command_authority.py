@@ -33,24 +33,32 @@ import rclpy
 from rclpy.duration import Duration
 from std_msgs.msg import Float64MultiArray, MultiArrayDimension
 name, label, count, value = sys.argv[1], sys.argv[2], int(sys.argv[3]), float(sys.argv[4])
+t0 = time.monotonic()
+def said(what):  # each step with its time: a stray that hangs shows where (run_strays)
+    print(f"{name} {time.monotonic() - t0:.1f} s: {what}", flush=True)
 rclpy.init()
 node = rclpy.create_node(name)
 # as deep as its commands: a busy reader that acknowledges late loses none (at depth 10, the
 # writer would drop what the device had not acknowledged yet, and the count would fall short)
 pub = node.create_publisher(Float64MultiArray, "effort_command", count)
+said("up")
 end = time.monotonic() + 60.0
 while pub.get_subscription_count() < 1 and time.monotonic() < end:
     time.sleep(0.01)
+said(f"{pub.get_subscription_count()} subscription(s) matched")
 msg = Float64MultiArray(data=[value])
 if label:
     msg.layout.dim = [MultiArrayDimension(label=label, size=1, stride=1)]
 for _ in range(count):
     pub.publish(msg)
     time.sleep(0.01)
+said(f"{count} published")
 if not pub.wait_for_all_acked(Duration(seconds=20.0)):
     raise SystemExit("the commands were not acknowledged within 20 s")
+said("acknowledged")
 node.destroy_node()
 rclpy.shutdown()
+said("shut down")
 """
 #: (node name, layout label) of each stray publisher
 STRAYS = (("stray_bare", ""), ("stray_stamped", "effort@0"), ("stray_guess", "effort@0#0123abcd"))
@@ -92,9 +100,20 @@ def run_strays(env: dict[str, str]) -> int:
         )
         for name, label in STRAYS
     ]
-    for p in procs:
-        out, _ = p.communicate(timeout=120)
-        assert p.returncode == 0, out.decode()
+    try:
+        for p in procs:
+            try:
+                out, _ = p.communicate(timeout=120)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                out, _ = p.communicate()
+                raise AssertionError(f"a stray publisher hung after:\n{out.decode()}") from None
+            assert p.returncode == 0, out.decode()
+    finally:
+        for p in procs:  # never left behind: only what this test started
+            if p.poll() is None:
+                p.kill()
+                p.wait()
     return COUNT * len(STRAYS)
 
 
