@@ -3,7 +3,8 @@
 (``haptic_dob.core.cycle``), every command on time.
 
 What a real-time session through ``bridge_node`` and a test driver does when every command
-arrives before the driver's next tick, sample for sample: the driver ticks its plant
+arrives before the driver's next tick (or, with ``late``, that share of them after it: this
+process held up, the next state waiting in its queue), sample for sample: the driver ticks its plant
 (``support.drivers.plants``) with the effort in force (a ros2_control driver writes the newest
 command at its next cycle; a Touch driver applies the newest force on arrival while its white
 button is held, here always), publishes its state (a Force Dimension's position, velocity and
@@ -48,6 +49,7 @@ class BridgeRecord:
     q: Arr  # as the bridge handed them on (the model's joints)
     qd: Arr  # the bridge's velocity
     effort: Arr  # the effort in force over [k-1, k) the bridge reported
+    applied: Arr  # the joint effort the plant had over [k-1, k)
     estimate: Arr  # the observer's wrench (N)
     hand: Arr  # the plant's true hand force (N)
     tip: Arr  # the plant's tip from its encoders (m)
@@ -67,10 +69,16 @@ class BridgeRecord:
 
 
 def run_bridge(
-    nodes: Mapping[str, Mapping[str, Any]], plant: Plant, seconds: float
+    nodes: Mapping[str, Mapping[str, Any]],
+    plant: Plant,
+    seconds: float,
+    late: float = 0.0,
+    seed: int = 0,
 ) -> BridgeRecord:
     """The session ``nodes`` (a bridge config's node sections) against ``plant`` for
-    ``seconds`` of driver time."""
+    ``seconds`` of driver time; each command late with probability ``late`` (``seed``): sent
+    1.3 periods after its state's instant, after the next state's instant, and that state heard
+    only after it (it waited in the queue); the driver takes it at the tick after."""
     v = node_view(nodes, "bridge_node")
     driver = DriverSettings.of(v)
     model = build_model(v)
@@ -78,7 +86,7 @@ def run_bridge(
     safety = build(SafetySettings, v, "safety.").check()
     bridge = BridgeLoop(driver, safety, model, reader.driver_joints, v["rate_hz"])
     bridge.start()
-    bridge.on_deadman(True)  # the dead-man held throughout (the white button: the driver's too)
+    bridge.on_deadman(True, 0.0)  # held throughout (the white button: the driver's too)
     env, obs, ctl = (
         node_view(nodes, n) for n in ("environment_node", "observer_node", "controller_node")
     )
@@ -96,23 +104,33 @@ def run_bridge(
     written = np.zeros(plant.dof)  # ros2_control: the command interfaces' values
     rows: list[tuple[Any, ...]] = []
     n = round(seconds * 1e9 / plant.period_ns)
+    period = plant.period_ns * 1e-9
+    rng = np.random.default_rng(seed)
+    pending: Arr | None = None  # a late command on its way: the driver takes it next tick
+    heard = 0.0  # when this process hears the next state (s)
+    applied = np.zeros(plant.dof)
     for k in range(n + 1):
         if k > 0:
             if touch:
                 F = held * min(1.0, TOUCH_MAX_FORCE_N / max(float(np.linalg.norm(held)), 1e-12))
                 J = plant.model._jacobian(np.asarray(plant.sample().q))
-                plant.apply((J.T @ F).tolist())
+                applied = J.T @ F  # a new array each tick
             else:
-                plant.apply(written.tolist())
+                applied = written.copy()
+            plant.apply(applied.tolist())
         s = plant.sample()
         if not touch:
             written = held.copy()  # the controller's update writes the newest command
+        if pending is not None:  # it came during [k, k+1): from the next tick on
+            held, pending = pending, None
         if touch:
             q6 = (*s.q, 0.0, 0.0, 0.0)
             state = reader.joints(s.stamp_ns, names, q6, (), ())
         else:
             state = reader.joints(s.stamp_ns, names, s.q, s.qd, s.effort)
-        sample, zero = bridge.on_state(state, k * plant.period_ns * 1e-9)
+        t = k * period  # the state's instant
+        at, heard = max(t, heard), t + period  # heard at its instant, or after a late command
+        sample, zero = bridge.on_state(state, at)
         held = _sent(zero, held)
         if sample is None:
             continue
@@ -125,15 +143,20 @@ def run_bridge(
             sample.ee_velocity,
             (0.0, 0.0, 0.0),
         )
-        held = _sent(bridge.on_command(EffortCommand(sample.stamp_ns, tuple(tau)), 0.0), held)
-        rows.append(
-            (s.stamp_ns, sample.q, sample.qd, sample.effort, f_est, s.hand_force, s.ee_position)
-        )
-    stamps, q, qd, effort, est, hand, tip = zip(*rows, strict=True)
+        command = EffortCommand(sample.stamp_ns, tuple(tau))
+        if rng.random() < late:  # after the next state's instant, which then waits for it
+            send = bridge.on_command(command, t + 1.3 * period)
+            pending = None if send is None else np.array(send.values, dtype=np.float64)
+            heard = t + 1.35 * period
+        else:
+            held = _sent(bridge.on_command(command, at + 0.1 * period), held)
+        truth = (applied, f_est, s.hand_force, s.ee_position)
+        rows.append((s.stamp_ns, sample.q, sample.qd, sample.effort, *truth))
+    stamps, q, qd, effort, applied_, est, hand, tip = zip(*rows, strict=True)
     return BridgeRecord(
         tuple(model.joint_names),
         np.array(stamps, dtype=np.int64),
-        *map(np.array, (q, qd, effort, est, hand, tip)),
+        *map(np.array, (q, qd, effort, applied_, est, hand, tip)),
         bridge.counts(),
     )
 

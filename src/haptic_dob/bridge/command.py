@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from haptic_dob.bridge.driver_settings import DriverSettings
 from haptic_dob.bridge.settings import per_element
@@ -66,11 +67,15 @@ class CommandMap:
                 out[slot] = s * float(tau[i])
         return tuple(out)
 
-    def back(self, u: Sequence[float], q: Sequence[float]) -> tuple[float, ...]:
-        """The model joint efforts the command elements ``u`` (SI) apply at ``q``."""
+    def back(
+        self, u: Sequence[float], q: Sequence[float], J: NDArray[np.float64] | None = None
+    ) -> tuple[float, ...]:
+        """The model joint efforts the command elements ``u`` (SI) apply at ``q`` (``J``: the
+        tip's Jacobian there, when known)."""
         if self.cartesian:
             F = [s * u[a] for a, s in zip(self.axes, self.axis_signs, strict=True)]
-            J = self.model._jacobian(np.asarray(q, dtype=np.float64))
+            if J is None:
+                J = self.model._jacobian(np.asarray(q, dtype=np.float64))
             return tuple((J.T @ np.asarray(F)).tolist())
         return tuple(
             0.0 if slot is None else s * u[slot]

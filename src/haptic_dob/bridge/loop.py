@@ -1,8 +1,8 @@
 """The bridge's cycle, ROS-free: a driver state to the loop, the loop's command to the driver.
 
 ``on_state`` turns driver state k into the loop's sample k (q, q', the effort in force over
-[k-1, k), the tip's point and velocity from the model's kinematics, the driver's stamp);
-``on_command`` turns the loop's command for it into the driver's at once (``CommandMap``,
+[k-1, k) by the driver's clock, ``DriverClock``; the tip's point and velocity; the driver's
+stamp); ``on_command`` turns the loop's command for it into the driver's at once (``CommandMap``,
 ``CommandLimiter``). Every way out is zero:
 
 - before ``start``, after ``stop``, and while the dead-man is released or never seen: zero on
@@ -22,6 +22,7 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from haptic_dob.bridge.command import CommandLimiter, CommandMap
 from haptic_dob.bridge.driver_settings import DriverSettings
@@ -60,6 +61,57 @@ def _quiet(_text: str) -> None:
     """Say nothing."""
 
 
+class DriverClock:
+    """Where the driver's stamps fall on this process's monotonic clock: a state's instant is
+    its stamp plus the least delay after its stamp at which any state of the last ``2 BLOCK``
+    was heard (a one-way hop when the driver's and this machine's clocks agree; it takes up an
+    offset when they do not, and receipt stamps).
+
+    A command counts from the driver's cycle whose instant it was sent before, not from the
+    first state this process handled after it: a state can wait in the queue while this
+    process is held up, and the command sent meanwhile is late for its cycle."""
+
+    BLOCK = 500  # states
+
+    def __init__(self) -> None:
+        self._origin_ns: int | None = None
+        self._older = self._newer = math.inf  # the least delay (s) in the last two blocks
+        self._count = 0
+
+    def heard(self, stamp_ns: int, now: float) -> float:
+        """State ``stamp_ns`` heard at monotonic ``now`` (s): its instant (monotonic s)."""
+        if self._origin_ns is None:
+            self._origin_ns = stamp_ns
+        t = (stamp_ns - self._origin_ns) * 1e-9
+        self._newer = min(self._newer, now - t)
+        self._count += 1
+        if self._count == self.BLOCK:
+            self._older, self._newer, self._count = self._newer, math.inf, 0
+        return t + min(self._older, self._newer)
+
+
+class SentLog:
+    """The commands sent (the driver's elements, SI), with their monotonic send times: which
+    was the newest at an instant (the ones before the log's reach: the last one it forgot)."""
+
+    def __init__(self, zero: tuple[float, ...], size: int = 64) -> None:
+        self._log: deque[tuple[float, tuple[float, ...]]] = deque(maxlen=size)
+        self._before = zero
+
+    def add(self, now: float, u: tuple[float, ...]) -> None:
+        """Command ``u`` sent at monotonic ``now`` (s)."""
+        if len(self._log) == self._log.maxlen:
+            self._before = self._log[0][1]
+        self._log.append((now, u))
+
+    def newest_before(self, t: float) -> tuple[float, ...]:
+        """The newest command sent strictly before monotonic ``t`` (s)."""
+        for sent_at, u in reversed(self._log):
+            if sent_at < t:
+                return u
+        return self._before
+
+
 class BridgeLoop:
     """One driver's bridge to the loop (see the module's notes).
 
@@ -93,8 +145,14 @@ class BridgeLoop:
         self.watchdog = CommandWatchdog(period_ns(rate_hz), self._tripped, self._resumed)
         self._say = say
         self._zero_model = (0.0,) * model.dof
-        self._sent_model = self._zero_model  # model efforts of the newest command sent
-        self._in_force: deque[tuple[float, ...]] = deque(maxlen=driver.delay_samples + 1)
+        self.clock = DriverClock()
+        self._sent = SentLog((0.0,) * n)  # the driver's elements sent, by send time
+        #: the previous state's q and tip Jacobian (None: not known)
+        self._prev: tuple[tuple[float, ...], NDArray[np.float64] | None] = (self._zero_model, None)
+        #: the instants of the newest states: the effort over [k-1, k) is the newest sent
+        #: before the instant of state k - delay_samples (the driver's update that wrote it)
+        self._instants: deque[float] = deque(maxlen=driver.delay_samples + 1)
+        self._newest_instant = 0.0
         self.deadman_held = safety.deadman == "none"
         self.started = False
         self.stopping = False
@@ -130,18 +188,20 @@ class BridgeLoop:
         if self.state_stale:
             self.state_stale = False
             self._say("driver state again: the loop resumes")
-        self._in_force.append(self._sent_model)
+        instant = self.clock.heard(s.stamp_ns, now)
+        self._instants.append(instant)
         if not self.started:
-            return None, self._zero(s.stamp_ns, "the loop is not up yet")
+            return None, self._zero(s.stamp_ns, "the loop is not up yet", now)
         if self.answered_ns != self.newest_ns and self.on_time + self.late:
-            self.late += 1  # the previous state got no command before this one
+            self.late += 1  # the previous state got no command at all
         self.k += 1
         self.newest_ns, self._newest_q, self._newest_t = s.stamp_ns, s.q, now
+        self._newest_instant = instant
         zero = None
         if self.watchdog.due(self.k, self.command_timeout_s):
-            zero = self._zero(s.stamp_ns, "no loop command")
+            zero = self._zero(s.stamp_ns, "no loop command", now)
         elif not self.deadman_held:
-            zero = self._zero(s.stamp_ns, "dead-man released")
+            zero = self._zero(s.stamp_ns, "dead-man released", now)
         return self._sample(s), zero
 
     def _sample(self, s: DriverState) -> LoopSample:
@@ -152,11 +212,15 @@ class BridgeLoop:
                 )
             effort = s.effort
         else:
-            full = len(self._in_force) == self._in_force.maxlen
-            effort = self._in_force[0] if full else self._zero_model
+            full = len(self._instants) == self._instants.maxlen
+            u = self._sent.newest_before(self._instants[0]) if full else None
+            # as a driver applies it over [k-1, k): at the posture of state k-1
+            effort = self._zero_model if u is None else self.map.back(u, *self._prev)
         q = np.asarray(s.q, dtype=np.float64)
         p = self.model._forward_kinematics(q)
-        v = self.model._jacobian(q) @ np.asarray(s.qd, dtype=np.float64)
+        J = self.model._jacobian(q)
+        self._prev = (s.q, J)
+        v = J @ np.asarray(s.qd, dtype=np.float64)
         return LoopSample(s.stamp_ns, s.q, s.qd, effort, (p[0], p[1], p[2]), (v[0], v[1], v[2]))
 
     # --- the loop's command ----------------------------------------------------------------
@@ -172,11 +236,14 @@ class BridgeLoop:
         tau = cmd.effort
         if len(tau) != self.model.dof or not all(map(math.isfinite, tau)):
             self.refused += 1
-            return self._zero(stamp, "refused a command of the wrong length or with NaN/inf")
+            return self._zero(stamp, "refused a command of the wrong length or with NaN/inf", now)
         self.watchdog.fed(self.k)
         self.answered_ns = stamp
-        if stamp == self.newest_ns:
-            self.on_time += 1
+        if stamp == self.newest_ns:  # before the driver's next cycle, or late for it
+            if now < self._newest_instant + self.period_s:
+                self.on_time += 1
+            else:
+                self.late += 1
             self.latency.add(now - self._newest_t)
         if not self.deadman_held:
             self.gated += 1
@@ -184,18 +251,18 @@ class BridgeLoop:
         u = self.limiter.limit(self.map.forward(tau, self._newest_q))
         if not all(map(math.isfinite, u)):  # a singular map, say: never sent
             self.refused += 1
-            return self._zero(stamp, "the command mapped to NaN/inf")
-        self._sent_model = self.map.back(u, self._newest_q)
+            return self._zero(stamp, "the command mapped to NaN/inf", now)
+        self._sent.add(now, u)
         return Send(tuple(x * self.scale for x in u), stamp, "")
 
     # --- safety inputs and time -------------------------------------------------------------
-    def on_deadman(self, held: bool) -> Send | None:
-        """The dead-man is ``held`` now: released sends zero at once."""
+    def on_deadman(self, held: bool, now: float) -> Send | None:
+        """The dead-man is ``held`` at monotonic ``now`` (s): released sends zero at once."""
         was, self.deadman_held = self.deadman_held, held
         if was and not held:
             self.deadman_releases += 1
             self._say("dead-man released: zero command until it is held again")
-            return self._zero(self.newest_ns, "dead-man released")
+            return self._zero(self.newest_ns, "dead-man released", now)
         if held and not was:
             self._say("dead-man held: the loop's commands pass")
         return None
@@ -213,22 +280,23 @@ class BridgeLoop:
                 f"no driver state for {self.state_timeout_s * 1e3:g} ms: zero command, the "
                 f"stale state is not rendered ({self.state_trips} trips so far)"
             )
-        return self._zero(self.newest_ns, "no driver state")
+        return self._zero(self.newest_ns, "no driver state", now)
 
     def start(self) -> None:
         """Hand the driver's states to the loop from the next one on."""
         self.started = True
 
-    def stop(self) -> Send:
-        """The end: zero now, nothing after."""
+    def stop(self, now: float) -> Send:
+        """The end at monotonic ``now`` (s): zero now, nothing after."""
         self.stopping = True
-        return self._zero(self.newest_ns, "stopping")
+        return self._zero(self.newest_ns, "stopping", now)
 
     # --- what goes out as zero ----------------------------------------------------------------
-    def _zero(self, stamp_ns: int, why: str) -> Send:
+    def _zero(self, stamp_ns: int, why: str, now: float) -> Send:
         self.zeros += 1
-        self._sent_model = self._zero_model
-        return Send(self.limiter.zero(), max(stamp_ns, 0), why)
+        u = self.limiter.zero()
+        self._sent.add(now, u)
+        return Send(u, max(stamp_ns, 0), why)
 
     def _tripped(self, held: str) -> None:
         self._say(

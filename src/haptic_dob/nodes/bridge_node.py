@@ -176,7 +176,7 @@ class BridgeNode(LoopNode):
             self._send_bytes(self._encode(send.stamp_ns, send.values))
 
     def _on_deadman(self, data: bytes) -> None:
-        self._send(self.loop.on_deadman(self._held(data)))
+        self._send(self.loop.on_deadman(self._held(data), time.monotonic()))
         self._say()
 
     def _on_estimate(self, js: JointSample) -> None:
@@ -228,7 +228,7 @@ class BridgeNode(LoopNode):
 
     def on_shutdown(self) -> None:
         """Zero to the driver first (acknowledged before the process ends, when reliable)."""
-        self._send(self.loop.stop())
+        self._send(self.loop.stop(time.monotonic()))
         self.log.info("shutdown: zero command sent to the driver")
         if self.run.stats_file:
             write_stats(self.run.stats_file, self.loop.counts())

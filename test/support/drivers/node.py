@@ -4,19 +4,20 @@
 writes ``truth.json`` (the plant's hidden parameters, counts, its last command) and
 ``series.npz`` (per cycle and per command) into the config's ``out`` directory. Config keys:
 ``kind`` (``fd``, ``touch``, ``arm``), ``rate_hz``, ``seed``, ``out``, ``hand``,
-``hand_direction``, ``button`` and ``inkwell`` (touch), ``table_z`` (arm); test controls in the
-driver's namespace: ``test/pause`` (``Float64``: no state for that many seconds) and
-``test/button`` (``Bool``).
+``hand_direction``, ``button`` and ``inkwell`` (touch), ``table_z`` (arm), ``rt_priority``
+(``realtime``); test controls in its namespace: ``test/pause`` (``Float64``: no state for that
+many seconds) and ``test/button`` (``Bool``).
 
-At tick k+1 the plant moves over [k, k+1) with the effort in force (ros2_control: the command
-written at tick k; Touch: the newest force), then state k+1 goes out stamped with the first
-tick's time plus k+1 periods: the instant its positions are true, as a real driver's stamp is
-(not the Python tick's jittery wall time). Command k is on time when it answers state k and
-arrives before tick k+1 (or, ``within_period``, within a period of the state going out)."""
+Tick k's instant is the first tick's plus k periods, and its state is stamped with it (when its
+positions are true, as a real driver's stamp is). ``DriverNode._tick`` says what a tick does.
+Command k is on time when it answers state k and DDS received it before tick k+1's instant
+(``within_period``: its first answer came within a period of the state going out)."""
 
 from __future__ import annotations
 
 import json
+import math
+import os
 import random
 import sys
 import time
@@ -34,12 +35,13 @@ from haptic_dob.runtime.ros.spin import LoopNode, run_nodes
 from haptic_msgs_py.ros.raw import raw_subscription
 from haptic_msgs_py.stamps import period_ns
 from support.drivers import plants
-from support.drivers.speak import LATCHED, Ros2Control, Touch
+from support.drivers.speak import LATCHED, Ros2Control, Touch, instant_ns
 
 TICKING = "ticking"  # the driver's first line once it ticks (``run.start`` waits for it)
 ARM_JOINTS = tuple(f"joint{i}" for i in range(1, 8))
 GRIPPER = "gripper_finger_joint"  # an extra joint the arm's model does not have
 FD_JOINTS = ("fd_x", "fd_y", "fd_z")
+CATCH_UP = 20  # periods a late tick catches up; a longer stall moves the grid on
 
 
 class DriverNode(LoopNode):
@@ -84,34 +86,46 @@ class DriverNode(LoopNode):
         self._force = np.zeros(3)  # touch: the Cartesian force in force (base frame)
         self.deadline = time.monotonic() + 0.2
         self.paused_until = 0.0
-        self._k = -1
-        self._t0_ns = 0  # the system clock at the first tick: sample 0's instant
+        self._k = -1  # ticks done (sample index)
+        self._n = 0  # the grid instant of the next tick (periods from the first)
+        self._t0_ns = 0  # the system clock at the first tick's instant: the grid's origin
         self._stamp = 0  # the newest state's stamp
-        self._t_sent = 0.0
+        self._sent_at: dict[int, int] = {}  # stamp -> system ns it went out, until answered
         self._answered = -1  # the newest stamp a command answered on time
         self.on_time = self.late = self.missed_ticks = self.states = 0
-        self._unanswered = 0  # ticks since the last on-time command: late once another comes
-        self.within_period = 0  # on-time commands that came within a period of their state
-        self.latency = LatencyHistogram()
+        self._unanswered = 0  # states since the last on-time command: late once another comes
+        self._marked = -1  # the newest state counted unanswered
+        #: states whose first answer came within a period of the state going out: on time for
+        #: a driver that publishes at its instant (this one is late at times)
+        self.within_period = 0
+        self._answered_from, self._answered_to = 2**63, -1  # the stamps first and last answered
+        self.latency = LatencyHistogram()  # s, a state going out -> its first answer received
         #: per tick: stamp, monotonic s, published (1/0), q..., effort..., hand (3), tip (3)
         self.ticks: list[tuple[float, ...]] = []
         self.commands: list[tuple[float, ...]] = []  # arrival (monotonic), stamp, values...
         self.tick_stamps: list[int] = []  # each tick's stamp, exact (ns)
+        self.tick_late: list[float] = []  # each tick's processing after its instant (s)
         self.answered: list[int] = []  # the stamp each command answers, exact (-1: none)
         self.last_command: tuple[float, ...] = ()
 
     # --- inputs ------------------------------------------------------------------------------
-    def _got(self, stamp_ns: int | None, values: tuple[float, ...]) -> None:
-        now = time.monotonic()
+    def _got(self, stamp_ns: int | None, values: tuple[float, ...], received_ns: int) -> None:
+        """A command taken (``speak.Inbox``), received at ``received_ns`` (system clock)."""
+        arrival = time.monotonic() - (time.time_ns() - received_ns) * 1e-9
         self.last_command = values
-        self.commands.append((now, float(-1 if stamp_ns is None else stamp_ns), *values))
+        self.commands.append((arrival, float(-1 if stamp_ns is None else stamp_ns), *values))
         self.answered.append(-1 if stamp_ns is None else stamp_ns)
+        sent = None if stamp_ns is None else self._sent_at.pop(stamp_ns, None)
+        if stamp_ns is not None and sent is not None:  # the state's first answer
+            self._answered_from = min(self._answered_from, stamp_ns)
+            self._answered_to = max(self._answered_to, stamp_ns)
+            age_s = (received_ns - sent) * 1e-9
+            self.latency.add(age_s)
+            self.within_period += age_s < self.period_s
         if stamp_ns == self._stamp and self._answered != self._stamp:
             self._answered = self._stamp
             self.on_time += 1
             self.late, self._unanswered = self.late + self._unanswered, 0
-            self.latency.add(now - self._t_sent)
-            self.within_period += now - self._t_sent < self.period_s
 
     def _on_button(self, msg: Any) -> None:
         self._button = bool(msg.data)
@@ -125,38 +139,61 @@ class DriverNode(LoopNode):
 
     def on_wakeup(self, now: float) -> None:
         if self._k < 0:
-            self.get_logger().info(f"{TICKING} at {self.cfg['rate_hz']} Hz")
+            self.get_logger().info(
+                f"{TICKING} at {self.cfg['rate_hz']} Hz under {self.cfg.get('scheduling')}"
+            )
+            self._t0_ns = instant_ns(self.deadline)
+        behind = int((now - self.deadline) / self.period_s)  # periods whose tick is past too
+        if behind > CATCH_UP:  # a long stall: the grid skips the rest (lost; the plant holds)
+            self.missed_ticks += behind - CATCH_UP
+            self._n += behind - CATCH_UP
+            self.deadline += (behind - CATCH_UP) * self.period_s
+            behind = CATCH_UP
+        for _ in range(behind + 1):  # every state of the grid goes out, stamped its instant
+            self._tick(now, publish=now >= self.paused_until)
+
+    def _tick(self, now: float, publish: bool) -> None:
+        """The cycle at grid instant ``self._n`` (deadline ``self.deadline``), processed at
+        monotonic ``now``: first the commands DDS received before that instant (``Inbox``: a
+        real driver's update does not wait for a late Python tick), then the plant over the
+        period before it with the effort in force (ros2_control: the command written at the
+        tick before; Touch: the newest force), its state out (``publish``), the controller's
+        update. A tick processed late first catches up the ticks already due, their states
+        going out at once, stamped their instants (``CATCH_UP`` at most: then the grid moves
+        on and states are lost)."""
+        stamp = self._t0_ns + self._n * self.period_ns
+        self.io.receive(stamp)  # the stamp is the tick's instant on the system clock
         if self._k >= 0:
-            if self._answered != self._stamp and self.on_time:
+            if self._answered != self._stamp and self.on_time and self._marked != self._stamp:
                 self._unanswered += 1
+                self._marked = self._stamp
             effort = self._effort()
             self._resting = self._resting and not any(self._force)
             if not self._resting:
                 self.plant.apply(effort)
         self._k += 1
         s = self.plant.sample()
-        if self._k == 0:
-            self._t0_ns = time.time_ns()
-        stamp = self._t0_ns + self._k * self.period_ns
         if self.kind == "touch":
             self.io.press(self._button, stamp)
-        published = now >= self.paused_until
-        if published:
+        if publish:
             self._publish(stamp, s)
         if self.kind == "fd" or self.kind == "arm":
             self._written = self.io.update()  # the controller's update: acts from this tick on
         applied = self._force if self.kind == "touch" else s.effort
-        row = (stamp, now, float(published), *s.q, *applied, *s.hand_force, *s.ee_position)
+        row = (stamp, now, float(publish), *s.q, *applied, *s.hand_force, *s.ee_position)
         self.ticks.append(row)
         self.tick_stamps.append(stamp)
+        self.tick_late.append(now - self.deadline)
+        self.missed_ticks += now - self.deadline > self.period_s
+        self._n += 1
         self.deadline += self.period_s
-        if now - self.deadline > self.period_s:
-            self.missed_ticks += int((now - self.deadline) / self.period_s)
-            self.deadline = now + self.period_s
         self.plant.prepare()
 
     def _publish(self, stamp: int, s: Any) -> None:
-        self._stamp, self._t_sent = stamp, time.monotonic()
+        self._stamp = stamp
+        self._sent_at[stamp] = time.time_ns()
+        if len(self._sent_at) > 256:  # states never answered (a pause of the loop's commands)
+            del self._sent_at[next(iter(self._sent_at))]
         self.states += 1
         if self.kind == "touch":
             self.io.publish(stamp, s.q)
@@ -186,7 +223,21 @@ class DriverNode(LoopNode):
         return tuple((J.T @ F).tolist())
 
     # --- the end -------------------------------------------------------------------------------
+    def _states_between(self, first_ns: int, last_ns: int) -> int:
+        """States published with stamps from ``first_ns`` to ``last_ns``."""
+        return sum(
+            1
+            for row, st in zip(self.ticks, self.tick_stamps, strict=True)
+            if row[2] and first_ns <= st <= last_ns
+        )
+
+    def _late_ms(self, pct: float) -> float:
+        """A percentile of the ticks' processing after their instants (ms)."""
+        return float(np.percentile(self.tick_late, pct)) * 1e3 if self.tick_late else math.nan
+
     def on_shutdown(self) -> None:
+        self.io.receive(None)  # the last commands that came (a bridge's zero on its way out)
+        self.io.inbox.close()
         out = Path(self.cfg["out"])
         out.mkdir(parents=True, exist_ok=True)
         counts = {
@@ -197,15 +248,19 @@ class DriverNode(LoopNode):
             "commands_late": self.late,  # between on-time ones: the loop's end is not late
             "ticks_after_last_command": self._unanswered,
             "commands_within_period": self.within_period,
+            "states_answered_span": self._states_between(self._answered_from, self._answered_to),
             "missed_ticks": self.missed_ticks,
             "latency_p50_ms": self.latency.percentile(50) * 1e3,
             "latency_p99_ms": self.latency.percentile(99) * 1e3,
+            "tick_late_p50_ms": self._late_ms(50),
+            "tick_late_p99_ms": self._late_ms(99),
             "nonfinite_dropped": self.io.nonfinite_dropped,
             "size_errors": getattr(self.io, "size_errors", 0),
         }
         truth = {
             "kind": self.kind,
             "rate_hz": self.cfg["rate_hz"],
+            "scheduling": self.cfg.get("scheduling", "default scheduling"),
             "plant": self.plant.truth(),
             "counts": counts,
             "last_command": list(self.last_command),
@@ -217,14 +272,33 @@ class DriverNode(LoopNode):
             ticks=np.array(self.ticks, dtype=np.float64),
             commands=np.array(self.commands, dtype=np.float64),
             tick_stamps=np.array(self.tick_stamps, dtype=np.int64),
+            tick_late=np.array(self.tick_late, dtype=np.float64),
             answered=np.array(self.answered, dtype=np.int64),
             dof=self.plant.dof,
         )
 
 
+def realtime(priority: int) -> str:
+    """SCHED_FIFO ``priority`` for this process (0: none), as a controller manager runs its
+    loop, where it may use more than one CPU; what it runs under (the threads started after
+    inherit it). On one CPU it keeps default scheduling: this Python driver's tick (the plant's
+    physics) takes a few hundred us, a real driver's tens, and under SCHED_FIFO it would hold
+    the loop off the only CPU for that long at every tick."""
+    if priority <= 0:
+        return "default scheduling"
+    if len(os.sched_getaffinity(0)) < 2:
+        return "default scheduling (one CPU)"
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except OSError as exc:
+        return f"default scheduling (SCHED_FIFO {priority} refused: {exc.strerror})"
+    return f"SCHED_FIFO {priority}"
+
+
 def main(argv: list[str]) -> int:
     """Run the driver of the config file ``argv[1]`` until a signal."""
     cfg = json.loads(Path(argv[1]).read_text())
+    cfg["scheduling"] = realtime(int(cfg.get("rt_priority", 0)))
     return run_nodes(lambda ctx: [DriverNode(cfg, ctx)], ["driver"])
 
 

@@ -10,15 +10,20 @@
   ``omni_state.cpp`` publishes them), the buttons as ``sensor_msgs/Joy`` on change (grey,
   white), and ``<ns>/force_feedback`` (``WrenchStamped``, reliable) applied on arrival only while
   the white button is held, clamped to the device's maximum, in the pose frame (the URDF's base
-  frame, no axis map; docs/devices.md has the driver's lines)."""
+  frame, no axis map; docs/devices.md has the driver's lines).
+
+Both take their commands through an ``Inbox``, by DDS reception time."""
 
 from __future__ import annotations
 
 import math
+import time
+from collections import deque
 from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
+from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from haptic_msgs_py import codecs, wire
@@ -38,8 +43,46 @@ LATCHED = QoSProfile(
     durability=DurabilityPolicy.TRANSIENT_LOCAL,
 )
 
-#: a command arrived: (stamp of the state it answers in ns or None, values), or None (dropped)
-Received = Callable[[int | None, tuple[float, ...]], None]
+#: a command taken: (stamp of the state it answers in ns or None, values, reception time in
+#: system-clock ns)
+Received = Callable[[int | None, tuple[float, ...], int], None]
+
+
+class Inbox:
+    """One command topic read the way a driver's update reads it: by reception time.
+
+    A real driver's update runs on its own clock and takes what DDS received before it
+    (ros2_control's realtime buffer, written by another thread), however late a Python test
+    driver's tick runs. So the subscription sits on a node of its own that no executor spins: a
+    message waits in DDS until ``take`` (the reader's ``qos`` depth bounds how many wait), and
+    the driver takes at each tick those received before the tick's instant.
+    """
+
+    def __init__(self, node: Any, typename: str, topic: str, qos: QoSProfile) -> None:
+        self._node = Node(f"{node.get_name()}_inbox", context=node.context)
+        self._sub = self._node.create_subscription(
+            rclpy_type(typename), topic, lambda _data: None, qos, raw=True
+        )
+        self._later: deque[tuple[int, bytes]] = deque()  # received after a tick's instant
+
+    def take(self, before_ns: int | None = None) -> list[tuple[int, bytes]]:
+        """Every message DDS received before ``before_ns`` (system clock; None: all), oldest
+        first, as (reception ns, serialized message); later ones wait for the next take."""
+        with self._sub.handle:
+            while (got := self._sub.handle.take_message(self._sub.msg_type, True)) is not None:
+                self._later.append((int(got[1]["received_timestamp"]), got[0]))
+        out = []
+        while self._later and (before_ns is None or self._later[0][0] < before_ns):
+            out.append(self._later.popleft())
+        return out
+
+    def close(self) -> None:
+        self._node.destroy_node()
+
+
+def instant_ns(deadline: float) -> int:
+    """Monotonic ``deadline`` (s) on the system clock (ns), as reception times are."""
+    return time.time_ns() - round((time.monotonic() - deadline) * 1e9)
 
 
 class Ros2Control:
@@ -69,12 +112,8 @@ class Ros2Control:
         self._pub = node.create_publisher(
             rclpy_type("sensor_msgs/msg/JointState"), f"{ns}/joint_states", SYSTEM_DEFAULT
         )
-        node.create_subscription(
-            rclpy_type("std_msgs/msg/Float64MultiArray"),
-            f"{ns}/{controller}/commands",
-            self._on_command,
-            SYSTEM_DEFAULT,
-            raw=True,
+        self.inbox = Inbox(
+            node, "std_msgs/msg/Float64MultiArray", f"{ns}/{controller}/commands", SYSTEM_DEFAULT
         )
         self._received = received
         self.held: tuple[float, ...] | None = None  # the newest message taken (never expires)
@@ -82,16 +121,19 @@ class Ros2Control:
         self.nonfinite_dropped = 0
         self.size_errors = 0  # updates that failed on a held command of the wrong size
 
-    def _on_command(self, data: bytes) -> None:
-        cmd = codecs.EFFORT.decode(data)
-        if not all(map(math.isfinite, cmd.effort)):
-            self.nonfinite_dropped += 1  # "Non-finite value received. Dropping message"
-            return
-        self.held = tuple(cmd.effort)
-        self._received(cmd.stamp_ns, self.held)
+    def receive(self, before_ns: int | None) -> None:
+        """Take the commands DDS received before ``before_ns`` (system ns; None: all)."""
+        for received_ns, data in self.inbox.take(before_ns):
+            cmd = codecs.EFFORT.decode(data)
+            if not all(map(math.isfinite, cmd.effort)):
+                self.nonfinite_dropped += 1  # "Non-finite value received. Dropping message"
+                continue
+            self.held = tuple(cmd.effort)
+            self._received(cmd.stamp_ns, self.held, received_ns)
 
     def update(self) -> tuple[float, ...]:
-        """The controller's update at a cycle: the newest command written, or an error."""
+        """The controller's update at a cycle (after ``receive``): the newest command written,
+        or an error."""
         if self.held is not None:
             if len(self.held) == len(self.command_joints):
                 self.written = self.held
@@ -124,25 +166,23 @@ class Touch:
         self._buttons_pub = node.create_publisher(
             rclpy_type("sensor_msgs/msg/Joy"), f"{ns}/buttons", SYSTEM_DEFAULT
         )
-        node.create_subscription(
-            rclpy_type("geometry_msgs/msg/WrenchStamped"),
-            f"{ns}/force_feedback",
-            self._on_force,
-            SYSTEM_DEFAULT,
-            raw=True,
+        self.inbox = Inbox(
+            node, "geometry_msgs/msg/WrenchStamped", f"{ns}/force_feedback", SYSTEM_DEFAULT
         )
         self._received = received
         self.force = (0.0, 0.0, 0.0)  # the newest force taken (driver axes)
         self.buttons = [0, 0]
         self.nonfinite_dropped = 0
 
-    def _on_force(self, data: bytes) -> None:
-        v = codecs.WRENCH.decode(data)
-        if not all(map(math.isfinite, v.vector)):
-            self.nonfinite_dropped += 1
-            return
-        self.force = tuple(v.vector)  # type: ignore[assignment]  # three floats
-        self._received(v.stamp_ns, self.force)
+    def receive(self, before_ns: int | None) -> None:
+        """Take the forces DDS received before ``before_ns`` (system ns; None: all)."""
+        for received_ns, data in self.inbox.take(before_ns):
+            v = codecs.WRENCH.decode(data)
+            if not all(map(math.isfinite, v.vector)):
+                self.nonfinite_dropped += 1
+                continue
+            self.force = tuple(v.vector)  # type: ignore[assignment]  # three floats
+            self._received(v.stamp_ns, self.force, received_ns)
 
     def press(self, held: bool, stamp_ns: int) -> None:
         """The white button held or let go: the Joy goes out on the change."""

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from haptic_dob.bridge.driver_settings import DriverSettings
-from haptic_dob.bridge.loop import BridgeLoop
+from haptic_dob.bridge.loop import BridgeLoop, DriverClock
 from haptic_dob.bridge.report import bridge_status, write_stats
 from haptic_dob.bridge.settings import SafetySettings
 from haptic_dob.bridge.state import DriverState
@@ -101,10 +101,10 @@ def test_the_deadman_gates_every_command() -> None:
     _, zero = b.on_state(state(1), 0.0)
     assert zero is not None and zero.zero_because == "dead-man released"  # never seen: released
     assert b.on_command(cmd(1), 0.0) is None and b.gated == 1
-    assert b.on_deadman(True) is None
+    assert b.on_deadman(True, 0.0) is None
     b.on_state(state(2), 0.0)
     assert b.on_command(cmd(2), 0.0) is not None
-    zero = b.on_deadman(False)
+    zero = b.on_deadman(False, 0.0)
     assert zero is not None and zero.values == (0.0, 0.0, 0.0) and b.deadman_releases == 1
 
 
@@ -132,9 +132,47 @@ def test_a_state_whose_stamp_did_not_advance_is_not_a_new_state_and_the_stop_is_
     b.on_state(state(2), 0.0)
     assert b.on_state(state(2), 0.0) == (None, None)
     assert b.on_state(state(1), 0.0) == (None, None)
-    stop = b.stop()
+    stop = b.stop(0.0)
     assert stop.values == (0.0, 0.0, 0.0) and stop.zero_because == "stopping"
     assert b.on_state(state(3), 0.0) == (None, None) and b.on_command(cmd(2), 0.0) is None
+
+
+@pytest.mark.parametrize("delay", [0, 1])
+def test_a_command_sent_after_the_drivers_next_instant_is_late_and_not_in_force_there(
+    delay: int,
+) -> None:
+    """States 1-4 heard 50 us after their stamps, each answered (k/2 N) 100 us later; then this
+    process is held up: state 5 is heard 1.2 ms late and answered, state 6 waited in the queue
+    behind it. Command 5 went out after state 6's instant: late, and not in force over [5, 6)
+    (delay 0) nor [6, 7) (delay 1, written at the cycle of state 6)."""
+    b = bridge(delay)
+    b.start()
+    efforts = {}
+    for k in range(1, 5):
+        efforts[k] = b.on_state(state(k), k * 1e-3 + 50e-6)[0].effort[0]  # type: ignore[union-attr]
+        b.on_command(cmd(k, k / 2, 0.0, 0.0), k * 1e-3 + 150e-6)
+    assert (b.on_time, b.late) == (4, 0)
+    efforts[5] = b.on_state(state(5), 6.2e-3)[0].effort[0]  # type: ignore[union-attr]
+    assert b.on_command(cmd(5, 2.5, 0.0, 0.0), 6.3e-3) is not None  # late, but sent
+    efforts[6] = b.on_state(state(6), 6.35e-3)[0].effort[0]  # type: ignore[union-attr]
+    b.on_command(cmd(6, 3.0, 0.0, 0.0), 6.4e-3)  # on time for state 7's instant (7.05 ms)
+    efforts[7] = b.on_state(state(7), 7.05e-3)[0].effort[0]  # type: ignore[union-attr]
+    assert (b.on_time, b.late) == (5, 1)
+    efforts[8] = b.on_state(state(8), 8.05e-3)[0].effort[0]  # type: ignore[union-attr]
+    if delay == 0:  # the newest sent before state k's instant
+        assert [efforts[k] for k in range(5, 9)] == [2.0, 2.0, 3.0, 3.0]
+    else:  # the newest sent before state k-1's instant
+        assert [efforts[k] for k in range(5, 9)] == [1.5, 2.0, 2.0, 3.0]
+
+
+def test_the_drivers_clock_may_be_another_one() -> None:
+    """Stamps on a clock 1000 s off this one, the least delay 40 us: instants on this clock."""
+    clock = DriverClock()
+    off = 1000 * 1_000_000_000
+    for k, extra in enumerate([0.3e-3, 40e-6, 0.1e-3, 5e-3]):
+        at = clock.heard(off + k * T, 2.0 + k * 1e-3 + extra)
+    assert at == pytest.approx(2.0 + 3e-3 + 40e-6)
+    assert clock.heard(off + 10 * T, 2.02) == pytest.approx(2.0 + 10e-3 + 40e-6)
 
 
 def test_late_commands_are_counted_per_state() -> None:
