@@ -114,7 +114,7 @@ ROWS = [
          "slave), 10 s: driver state -> command latency against one raw hop, commands before "
          "the driver's next state", "benchmarks.py", "bridge", "--repeat", "3"),
     _row("bridge", "the same, the loop and the driver under SCHED_FIFO 50 (`--rt-priority 50`; "
-         "the driver under `chrt -f 50`, as a controller manager runs)", "benchmarks.py",
+         "the driver under SCHED_FIFO 50 too, as a controller manager runs)", "benchmarks.py",
          "bridge", "--repeat", "3", "--rt-priority", "50"),
     _row("bridge", "the same under SCHED_FIFO 50, the driver and the loop on CPU 1 alone "
          "(`--cpus 1`: the CPU this machine stalls least, below)", "benchmarks.py",

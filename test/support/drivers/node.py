@@ -98,7 +98,8 @@ class DriverNode(LoopNode):
         #: states whose first answer came within a period of the state going out: on time for
         #: a driver that publishes at its instant (this one is late at times)
         self.within_period = 0
-        self._answered_from, self._answered_to = 2**63, -1  # the stamps first and last answered
+        #: the first state answered on time, the last state first answered from it on
+        self._answered_from, self._answered_to = 2**63, -1
         self.latency = LatencyHistogram()  # s, a state going out -> its first answer received
         #: per tick: stamp, monotonic s, published (1/0), q..., effort..., hand (3), tip (3)
         self.ticks: list[tuple[float, ...]] = []
@@ -115,17 +116,18 @@ class DriverNode(LoopNode):
         self.last_command = values
         self.commands.append((arrival, float(-1 if stamp_ns is None else stamp_ns), *values))
         self.answered.append(-1 if stamp_ns is None else stamp_ns)
-        sent = None if stamp_ns is None else self._sent_at.pop(stamp_ns, None)
-        if stamp_ns is not None and sent is not None:  # the state's first answer
-            self._answered_from = min(self._answered_from, stamp_ns)
-            self._answered_to = max(self._answered_to, stamp_ns)
-            age_s = (received_ns - sent) * 1e-9
-            self.latency.add(age_s)
-            self.within_period += age_s < self.period_s
         if stamp_ns == self._stamp and self._answered != self._stamp:
             self._answered = self._stamp
             self.on_time += 1
             self.late, self._unanswered = self.late + self._unanswered, 0
+            self._answered_from = min(self._answered_from, stamp_ns)
+        sent = None if stamp_ns is None else self._sent_at.pop(stamp_ns, None)
+        if stamp_ns is not None and sent is not None:  # the state's first answer
+            age_s = (received_ns - sent) * 1e-9
+            self.latency.add(age_s)
+            if stamp_ns >= self._answered_from:  # counted as on time is: from the first one
+                self._answered_to = max(self._answered_to, stamp_ns)
+                self.within_period += age_s < self.period_s
 
     def _on_button(self, msg: Any) -> None:
         self._button = bool(msg.data)
