@@ -10,10 +10,11 @@ from pathlib import Path
 import pytest
 
 from haptic_dob.bridge.driver_settings import DriverSettings
-from haptic_dob.bridge.loop import BridgeLoop, DriverClock
+from haptic_dob.bridge.loop import BridgeLoop
 from haptic_dob.bridge.report import bridge_status, write_stats
 from haptic_dob.bridge.settings import SafetySettings
 from haptic_dob.bridge.state import DriverState
+from haptic_dob.bridge.timeline import DriverClock
 from haptic_dob.core.models.point_mass import PointMassModel
 from haptic_msgs_py.values import EffortCommand
 
