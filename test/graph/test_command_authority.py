@@ -6,9 +6,11 @@ hosts (``--only``: no shared command token, the device takes its controller's by
 Publishers in other processes on the same domain and namespace then send ``effort_command`` the
 way ``ros2 topic pub`` does (a plain rclpy publisher, reliable, waiting for a match; one without a
 layout label, one labelled with a stamp, one with a stamp and a guessed token), each an effort the
-loop's controller never commands. By default none of them shows in the applied effort, the device
-counts every one in ``/diagnostics`` and names each publisher once in its log, and the loop goes
-on under its own controller; with ``open_command_input`` their commands arrive and move it.
+loop's controller never commands, and stay in the graph until the test ends, as ``ros2 topic
+pub`` does until stopped. By default none of them shows in the applied effort, the device counts
+every one in ``/diagnostics`` and names each publisher once in its log (once the graph lists it:
+under load, a stray's commands can come first), and the loop goes on under its own controller;
+with ``open_command_input`` their commands arrive and move it.
 """
 
 from __future__ import annotations
@@ -16,6 +18,9 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -56,6 +61,7 @@ said(f"{count} published")
 if not pub.wait_for_all_acked(Duration(seconds=20.0)):
     raise SystemExit("the commands were not acknowledged within 20 s")
 said("acknowledged")
+sys.stdin.read()  # in the graph until the test closes stdin, as ros2 topic pub until stopped
 node.destroy_node()
 rclpy.shutdown()
 said("shut down")
@@ -89,32 +95,43 @@ def device_values(col: Collector, since: int) -> dict[str, str]:
     return {}
 
 
-def run_strays(env: dict[str, str]) -> int:
-    """Every stray publisher's commands, sent at once from processes of their own; how many."""
-    procs = [
-        subprocess.Popen(
-            [sys.executable, "-c", STRAY, name, label, str(COUNT), repr(VALUE)],
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-        )
-        for name, label in STRAYS
-    ]
+def settled(proc: subprocess.Popen[bytes], log: Path) -> bool:
+    """A stray's commands were all acknowledged, or it exited."""
+    return proc.poll() is not None or "acknowledged" in log.read_text()
+
+
+@contextmanager
+def strays(env: dict[str, str], out: Path) -> Iterator[int]:
+    """Every stray publisher's commands, sent at once from processes of their own, which stay
+    in the graph while the block runs; how many commands they sent (all acknowledged)."""
+    logs = [out / f"{name}.log" for name, _ in STRAYS]
+    procs = []
     try:
+        for (name, label), log in zip(STRAYS, logs, strict=True):
+            with log.open("wb") as sink:
+                procs.append(
+                    subprocess.Popen(
+                        [sys.executable, "-c", STRAY, name, label, str(COUNT), repr(VALUE)],
+                        env=env,
+                        stdin=subprocess.PIPE,
+                        stdout=sink,
+                        stderr=subprocess.STDOUT,
+                    )
+                )
+        for p, log in zip(procs, logs, strict=True):
+            acked = wait_until(partial(settled, p, log), 120)
+            assert acked and p.poll() is None, f"a stray hung or failed:\n{log.read_text()}"
+        yield COUNT * len(STRAYS)
         for p in procs:
-            try:
-                out, _ = p.communicate(timeout=120)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                out, _ = p.communicate()
-                raise AssertionError(f"a stray publisher hung after:\n{out.decode()}") from None
-            assert p.returncode == 0, out.decode()
+            assert p.stdin is not None
+            p.stdin.close()
+        for p, log in zip(procs, logs, strict=True):
+            assert p.wait(timeout=30) == 0, log.read_text()
     finally:
         for p in procs:  # never left behind: only what this test started
             if p.poll() is None:
                 p.kill()
                 p.wait()
-    return COUNT * len(STRAYS)
 
 
 def session(layout: str, open_input: bool, tmp_path: Path) -> dict[str, Any]:
@@ -135,10 +152,17 @@ def session(layout: str, open_input: bool, tmp_path: Path) -> dict[str, Any]:
         log = lambda: "\n".join(p.output() for p in procs)  # noqa: E731
         assert col.wait_for(JOINT_STATES, 1000, 120), log()
         diag_from = col.count(DIAGNOSTICS)
-        sent = run_strays(env)
         key = "foreign_commands_taken" if open_input else "foreign_commands_refused"
-        counted = wait_until(lambda: int(device_values(col, diag_from).get(key, "0")) >= sent, 30)
-        values = device_values(col, diag_from)
+        said = "taking" if open_input else "refused"
+        with strays(env, tmp_path) as sent:
+            counted = wait_until(
+                lambda: int(device_values(col, diag_from).get(key, "0")) >= sent, 30
+            )
+            named = [
+                rf"{said} effort_command from /{name} \(GID [0-9a-f.]+\)" for name, _ in STRAYS
+            ]
+            wait_until(lambda: all(re.search(n, log()) for n in named), 30)
+            values = device_values(col, diag_from)
         n = col.count(JOINT_STATES)
         assert col.wait_for(JOINT_STATES, n + 500, 60), log()  # the loop still runs
         efforts = [m.effort[0] for m in col.decoded(JOINT_STATES)()]
@@ -162,7 +186,7 @@ def test_a_stray_publisher_moves_nothing_and_is_counted_and_named_once(
     assert any(e != 0.0 for e in run["efforts"])
     assert run["counted"], f"{values}\n{log[-3000:]}"
     assert int(values["foreign_commands_refused"]) == run["sent"], values
-    for name, _ in STRAYS:
+    for name, _ in STRAYS:  # by its name, once the graph listed it; only once
         said = re.findall(rf"refused effort_command from /{name} \(GID [0-9a-f.]+\)", log)
         assert len(said) == 1, f"{name} named {len(said)} times\n{log[-3000:]}"
         assert f"/{name} (GID " in values["foreign_publishers"]

@@ -10,8 +10,8 @@ that arrives while the middleware's graph shows that node as the only publisher 
 outside this process (taken again when its endpoint GIDs change: a restarted controller). While a
 publisher of the topic is in this process, a command from elsewhere with its token is the
 middleware's copy of one already taken: dropped. Every other command is refused (counted, each
-publisher named once) unless the input is open (bench work): then it is taken. Not
-authentication: docs/safety.md says what this does and does not keep out.
+publisher named once, when the graph lists it) unless the input is open (bench work): then it
+is taken. Not authentication: docs/safety.md says what this does and does not keep out.
 """
 
 from __future__ import annotations
@@ -54,6 +54,10 @@ class Graph(Protocol):
 
     def publishers(self) -> Sequence[Endpoint]:
         """The topic's publishers outside this process, as the graph shows them now."""
+
+    def unlisted(self) -> int:
+        """Publishers the input had matched that the last ``publishers()`` did not list (the
+        graph not told of them yet)."""
 
 
 class Verdict(Enum):
@@ -107,6 +111,9 @@ class CommandAuthority:
         self._looked_matched = -1
         self._outside: frozenset[str] = frozenset()
         self._unnamed_said = False
+        self._unlisted = 0  # matched publishers the last look did not list
+        #: a refusal came while some were unlisted: (when, taken?, the GIDs listed then, found?)
+        self._awaiting: tuple[float, bool, frozenset[str], bool] | None = None
 
     @property
     def mode(self) -> str:
@@ -147,11 +154,14 @@ class CommandAuthority:
 
     def follow_up(self) -> None:
         """Name the publishers whose commands came while the graph did not know their node yet
-        (call it now and then): once the graph knows it, or by the GID after ``NAME_GRACE_S``."""
-        if not self._pending:
+        (call it now and then): once the graph knows it, or by the GID after ``NAME_GRACE_S``;
+        and those matched but not listed at a refusal, once the graph lists them."""
+        if not self._pending and self._awaiting is None:
             return
         self._look(force=True)
         now = self._clock()
+        if self._awaiting is not None:
+            self._follow_unlisted(now, *self._awaiting)
         strangers = {e.gid: e for e in self.strangers}
         for gid, (first, taking) in list(self._pending.items()):
             e = strangers.get(gid)
@@ -173,6 +183,7 @@ class CommandAuthority:
         outside = tuple(self.graph.publishers())
         self.strangers = tuple(e for e in outside if e.node != self.source)
         self.source_gids = frozenset(e.gid for e in outside if e.node == self.source)
+        self._unlisted = self.graph.unlisted()
         gids = frozenset(e.gid for e in outside)
         if gids != self._outside:
             self._outside = gids
@@ -198,14 +209,41 @@ class CommandAuthority:
                 self._say(e, taking)
             else:
                 self._pending[e.gid] = (self._clock(), taking)
-        if not self.strangers and not taking and not self._unnamed_said:
-            self._unnamed_said = True
-            named_as_source = ", ".join(sorted(self.source_gids)) or "none now"
-            self._warn(
-                "refused effort_command without the expected token from a publisher the graph "
-                f"does not tell apart by name (gone already, or named {self.source}: GIDs "
-                f"{named_as_source}); counted in /diagnostics"
-            )
+        if self._unlisted > 0:  # the sender may be one the graph does not list yet
+            if self._awaiting is None:
+                self._awaiting = (self._clock(), taking, self._outside, False)
+        elif not self.strangers and not taking:
+            self._say_unnamed()
+
+    def _follow_unlisted(
+        self, now: float, first: float, taking: bool, known: frozenset[str], found: bool
+    ) -> None:
+        """Name the publishers the graph listed since a refusal found some unlisted. One that
+        left unlisted, or is still unlisted after ``NAME_GRACE_S``, is said not to be named."""
+        for e in self.strangers:
+            if e.gid not in known and e.gid not in self.named and e.gid not in self._pending:
+                found = True
+                if e.node:
+                    self._say(e, taking)
+                else:
+                    self._pending[e.gid] = (first, taking)
+        done = self._unlisted == 0 or now - first >= NAME_GRACE_S
+        self._awaiting = None if done else (first, taking, known, found)
+        if done and not taking and (self._unlisted > 0 or not found):
+            self._say_unnamed()
+
+    def _say_unnamed(self) -> None:
+        """Say once (per change of the graph's publishers) that a refused command's publisher
+        cannot be named."""
+        if self._unnamed_said:
+            return
+        self._unnamed_said = True
+        named_as_source = ", ".join(sorted(self.source_gids)) or "none now"
+        self._warn(
+            "refused effort_command without the expected token from a publisher the graph "
+            f"does not tell apart by name (gone already, not listed yet, or named {self.source}: "
+            f"GIDs {named_as_source}); counted in /diagnostics"
+        )
 
     def _say(self, e: Endpoint, taking: bool) -> None:
         node = e.node or "a publisher whose node the graph does not name"

@@ -66,6 +66,7 @@ class CommandInput:
         self._take = take
         self._here = ""  # the token of the commands handed over in this process
         self._said_refused = 0
+        self._listed = 0  # the topic's publishers the graph listed at the last look
         self.authority = CommandAuthority(
             qualified(values["command_source"], node.get_namespace()),
             self,
@@ -108,7 +109,9 @@ class CommandInput:
         """The topic's publishers outside this process (by node name), as the graph shows them."""
         here = self.bus.nodes
         out = []
-        for info in self.node.get_publishers_info_by_topic(self.sub.topic):
+        infos = self.node.get_publishers_info_by_topic(self.sub.topic)
+        self._listed = len(infos)
+        for info in infos:
             if (info.node_name, info.node_namespace) == UNKNOWN:
                 name = ""
             else:
@@ -116,6 +119,11 @@ class CommandInput:
             if name not in here:
                 out.append(Endpoint(name, gid_text(info.endpoint_gid)))
         return out
+
+    def unlisted(self) -> int:
+        """Publishers the DDS input has matched beyond those the last ``publishers()`` listed
+        (here and elsewhere)."""
+        return max(0, self.matched() - self._listed)
 
     # --- what the node reports --------------------------------------------------------------
     def get_publisher_count(self) -> int:

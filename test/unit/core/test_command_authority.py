@@ -27,14 +27,18 @@ class FakeGraph:
 
     def __init__(self, *endpoints: Endpoint) -> None:
         self.endpoints = list(endpoints)
+        self.hidden = 0  # publishers matched that the graph does not list yet
         self.looks = 0
 
     def matched(self) -> int:
-        return len(self.endpoints)
+        return len(self.endpoints) + self.hidden
 
     def publishers(self) -> Sequence[Endpoint]:
         self.looks += 1
         return list(self.endpoints)
+
+    def unlisted(self) -> int:
+        return self.hidden
 
 
 class Clock:
@@ -164,3 +168,47 @@ def test_a_refusal_nobody_in_the_graph_can_be_named_for_is_said_once() -> None:
     a.admit("")
     a.admit("x")
     assert a.refused == 2 and len(warned) == 1 and "01.aa" in warned[0]
+
+
+@pytest.mark.parametrize("beside", [(), (STRAY,)])
+def test_a_publisher_matched_before_the_graph_lists_it_is_named_once_it_is_listed(
+    beside: tuple[Endpoint, ...],
+) -> None:
+    """A stray's commands arrive (the input matched it) before the graph lists it, beside
+    another stray already named or none: it is named when the graph lists it, not before, and
+    nothing generic is said."""
+    graph = FakeGraph(CTL, *beside)
+    graph.hidden = 1
+    a, warned, _, clock = authority(graph, token="s3cret")
+    a.admit("")
+    a.admit("")
+    assert len(warned) == len(beside)  # only the one listed
+    clock.t += 0.5
+    a.follow_up()  # still unlisted: wait
+    assert len(warned) == len(beside)
+    graph.hidden, late = 0, Endpoint("/ns/late", "04.dd")
+    graph.endpoints.append(late)
+    a.follow_up()
+    assert len(warned) == len(beside) + 1 and "/ns/late (GID 04.dd)" in warned[-1]
+    a.follow_up()
+    a.admit("")
+    assert len(warned) == len(beside) + 1 and a.refused == 3
+
+
+@pytest.mark.parametrize("leaves", [False, True])
+def test_a_publisher_that_the_graph_never_lists_is_said_once_as_unnamed(leaves: bool) -> None:
+    """Gone before the graph listed it (the matched count falls back), or still unlisted after
+    the grace: one line says a refused publisher cannot be named."""
+    graph = FakeGraph(CTL, STRAY)
+    graph.hidden = 1
+    a, warned, _, clock = authority(graph, token="s3cret")
+    a.admit("")
+    assert len(warned) == 1  # the stray listed
+    if leaves:
+        graph.hidden = 0
+    else:
+        clock.t += NAME_GRACE_S
+    a.follow_up()
+    assert len(warned) == 2 and "does not tell apart by name" in warned[-1]
+    a.follow_up()
+    assert len(warned) == 2
