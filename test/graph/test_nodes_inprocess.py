@@ -284,6 +284,73 @@ def test_composed_in_ol_the_command_goes_out_before_the_observer_works(monkeypat
         rclpy.try_shutdown(context=ctx)
 
 
+@pytest.mark.parametrize("passivity", [False, True])
+def test_composed_the_slaves_command_goes_out_before_its_estimate_is_made(
+    monkeypatch, passivity: bool
+) -> None:
+    """A teleoperation slave (the 7-DOF arm's URDF) composed: its channel end, its controller
+    and its observer. Without the passivity controller, the point to track needs no force, so
+    command k goes out before the observer's estimate k is made, and the message to the master
+    after it; with the controller on, the point waits for the estimate."""
+    from rclpy.node import Node
+
+    from haptic_msgs_py import codecs
+    from haptic_msgs_py.bus import bus_for
+    from haptic_msgs_py.ros import qos
+    from haptic_msgs_py.ros.loop_io import LoopPublisher
+    from haptic_msgs_py.topics import (
+        EE_POSE,
+        EE_TWIST,
+        EFFORT_COMMAND,
+        JOINT_STATES,
+        POSE_DESIRED,
+        WRENCH_ESTIMATE,
+    )
+
+    monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
+    urdf = Path(__file__).resolve().parents[2] / "config" / "urdf" / "arm7.urdf"
+    ctx = Context()
+    params = (
+        "model:=urdf",
+        f"urdf_path:={urdf}",
+        "tip_frame:=tool",
+        "role:=slave",
+        f"channel.passivity:={str(passivity).lower()}",
+        "wait_for_peer:=false",  # real time: the master is not here
+    )
+    rclpy.init(context=ctx, args=["--ros-args", *(x for p in params for x in ("-p", p))])
+    log: list[tuple[str, int]] = []  # in the order they are published: called before the nodes
+    for topic in (EFFORT_COMMAND, WRENCH_ESTIMATE, POSE_DESIRED):
+        bus_for(ctx).add_subscriber(
+            f"/{topic}", lambda v, t=topic: log.append((t, v.stamp_ns)), lambda: 0, first=True
+        )
+    obs, chan = ObserverNode(context=ctx), ChannelNode(context=ctx)
+    ctl = SlaveControllerNode(context=ctx)
+    device = Node("device", context=ctx)
+    p_js = LoopPublisher(device, JOINT_STATES, codecs.JOINT_STATE, qos.LOOP, "world")
+    p_pose = LoopPublisher(device, EE_POSE, codecs.POSE, qos.LOOP, "world")
+    p_twist = LoopPublisher(device, EE_TWIST, codecs.TWIST, qos.LOOP, "world")
+    names = tuple(obs.model.joint_names)
+    q = (0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8)
+    tip = tuple(float(x) for x in obs.model.forward_kinematics(q))
+    try:
+        stamps = [k * 1_000_000 for k in range(1, 4)]  # at the default 1 kHz
+        for stamp in stamps:  # as the bridge publishes a state: the point, then the joints
+            p_pose.publish(StampedVector(stamp, tip))
+            p_twist.publish(StampedVector(stamp, (0.0, 0.0, 0.0)))
+            p_js.publish(JointSample(stamp, names, q, (0.0,) * 7, (0.0,) * 7))
+        order = (
+            [POSE_DESIRED, EFFORT_COMMAND, WRENCH_ESTIMATE]
+            if not passivity
+            else [WRENCH_ESTIMATE, POSE_DESIRED, EFFORT_COMMAND]
+        )
+        assert log == [(t, s) for s in stamps for t in order], log
+    finally:
+        for n in (device, ctl, chan, obs):
+            n.destroy_node()
+        rclpy.try_shutdown(context=ctx)
+
+
 @pytest.mark.parametrize("wait_for", ["[absent_node]", "[]"])
 def test_a_realtime_device_ticks_only_once_its_graph_is_up(monkeypatch, wait_for: str) -> None:
     """In real time as in lockstep the device waits for ``wait_for`` (and says for what);

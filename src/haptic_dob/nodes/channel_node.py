@@ -28,7 +28,7 @@ from haptic_dob.nodes.settings import ChannelEnd, LoopInputs, LoopTiming, Proces
 from haptic_dob.runtime.params import ParamSpec, build, specs_of
 from haptic_dob.runtime.ros.diagnostics import OK, WARN, Diagnostics, Report
 from haptic_dob.runtime.ros.spin import LoopNode
-from haptic_dob.teleop.ends import MasterEnd, PortMessage, SlaveEnd
+from haptic_dob.teleop.ends import MasterEnd, PortMessage, SlaveEnd, Vec3
 from haptic_dob.teleop.graph import TO_MASTER, TO_SLAVE
 from haptic_dob.teleop.settings import ChannelSettings, TeleopSettings
 from haptic_msgs_py import codecs
@@ -142,6 +142,7 @@ class ChannelNode(LoopNode):
         self._force: StampedVector | None = None
         self._done_ns = -1
         self._answer: Any = None
+        self._tracked: tuple[int, Vec3, Vec3] | None = None  # the slave's, its force not here
         self.diagnostics = Diagnostics(self, self._report)
 
     def _fallback(self) -> str:
@@ -166,30 +167,64 @@ class ChannelNode(LoopNode):
 
     # --- the cycle -------------------------------------------------------------------------
     def _step(self, sample: bool) -> None:
-        """Answer the newest sample once its inputs (and, in lockstep, the peer's) are here."""
+        """Answer the newest sample once its inputs (and, in lockstep, the peer's) are here. The
+        slave's point to track goes out on its point alone unless the passivity controller
+        needs the force (its controller's command then does not wait for the estimate), and its
+        message to the master once the force came (``_finish``)."""
+        tracked = self._tracked  # a sample awaiting its force goes first
+        if tracked is not None and not (self._finish(tracked) and self._newer(tracked[0])):
+            return
         pose, twist = self._pose, self._twist
         if pose is None or twist is None or pose.stamp_ns != twist.stamp_ns:
             return
         k = pose.stamp_ns
-        force = self._force
-        if self.role == "slave" and (force is None or force.stamp_ns != k):
-            return
         if k <= self._done_ns:
             if k == self._done_ns and sample:  # the same sample again: the same answer
                 self._out.publish(self._answer)
             return
         if self.wait and not self.end.ready(k):
             return  # the peer's message is on its way
-        if isinstance(self.end, MasterEnd):
-            value, message = self.end.cycle(k, pose.vector, twist.vector)
-        else:
-            assert force is not None
-            value, message = self.end.cycle(k, pose.vector, twist.vector, force.vector)
+        end = self.end
+        if isinstance(end, MasterEnd):
+            value, message = end.cycle(k, pose.vector, twist.vector)
+            self._answer_with(k, value)
+            self._send(k, message)
+            return
+        force = self._force.vector if self._force and self._force.stamp_ns == k else None
+        if force is None and end.target_needs_force:
+            return
+        self._answer_with(k, end.track(k, pose.vector, force))
+        self._tracked = (k, pose.vector, twist.vector)
+        self._finish(self._tracked)
+
+    def _finish(self, tracked: tuple[int, Vec3, Vec3]) -> bool:
+        """The slave's sample tracked: its message once its force is here; skipped when a newer
+        force came first (real time: its estimate was lost). Whether it is done with."""
+        end, (k, position, velocity), force = self.end, tracked, self._force
+        assert isinstance(end, SlaveEnd)
+        if force is None or force.stamp_ns < k:
+            return False  # its force is on its way
+        self._tracked = None
+        if force.stamp_ns > k:
+            end.forget()
+            self._done_ns = k
+            return True
+        self._send(k, end.message(k, position, velocity, force.vector))
+        return True
+
+    def _newer(self, k: int) -> bool:
+        """A sample newer than ``k`` is here."""
+        return self._pose is not None and self._pose.stamp_ns > k
+
+    def _send(self, k: int, message: PortMessage) -> None:
         self._done_ns = k
-        self._answer = StampedVector(k, value)
-        self._out.publish(self._answer)  # the local loop first
         self._link.publish(to_wire(message))
         self.diagnostics.tick()
+
+    def _answer_with(self, k: int, value: tuple[float, float, float]) -> None:
+        """Sample k's answer to the local loop (the wall force, or the point to track)."""
+        self._answer = StampedVector(k, value)
+        self._out.publish(self._answer)
 
     def next_sample_ns(self) -> int | None:
         """No parameter changes at run time (all read-only)."""

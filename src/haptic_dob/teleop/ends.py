@@ -199,12 +199,27 @@ class SlaveEnd(_End):
         self.target: Vec3 = ZERO_FORCE  # the point the slave tracks (m, slave frame)
         self._disp: Vec3 = ZERO_FORCE  # the master's displacement the target last followed
         self.holding = False
+        self._unbooked: Vec3 | None = None  # the velocity ``track`` sent, its power not booked
+
+    @property
+    def target_needs_force(self) -> bool:
+        """The point to track depends on the sample's force: the passivity controller acts."""
+        return self.port.enabled
 
     def cycle(
         self, stamp_ns: int, position: Vec3, velocity: Vec3, force: Force
     ) -> tuple[Vec3, PortMessage]:
         """Sample k's point (m), velocity (m/s) and contact force (N), slave frame -> the point
         to track and the message to the master."""
+        target = self.track(stamp_ns, position, force)
+        return target, self.message(stamp_ns, position, velocity, force)
+
+    def track(self, stamp_ns: int, position: Vec3, force: Force | None = None) -> Vec3:
+        """Sample k's point to track (m, slave frame), from its point (m) and, when
+        ``target_needs_force``, its contact force (N); without it (``None``) the force is
+        booked by ``message``, which must follow for the same sample."""
+        if force is None and self.target_needs_force:
+            raise ValueError("the passivity controller needs the sample's force")
         if self.origin is None:
             self.origin = self.target = position
         msg = self._incoming(self.clock.index(stamp_ns))
@@ -212,7 +227,9 @@ class SlaveEnd(_End):
             if not self.holding:  # hold where it is
                 self.holding = True
                 self.target = position
-            self.port.admittance(ZERO_FORCE, force)  # no flow: books nothing
+            v: Vec3 = ZERO_FORCE  # no flow: books nothing
+            if force is not None:
+                self.port.admittance(v, force)
         else:
             d = msg.position if msg is not None else self._disp
             if self.holding:  # back after a silence: go on from the held point, no jump
@@ -221,10 +238,26 @@ class SlaveEnd(_End):
             d0 = self._disp
             T = self.dt
             v = ((d[0] - d0[0]) / T, (d[1] - d0[1]) / T, (d[2] - d0[2]) / T)
-            v = self.port.admittance(v, force)
+            if force is not None:
+                v = self.port.admittance(v, force)
             p = self.target
             self.target = (p[0] + v[0] * T, p[1] + v[1] * T, p[2] + v[2] * T)
             self._disp = d
+        self._unbooked = None if force is not None else v
+        return self.target
+
+    def forget(self) -> None:
+        """The sample ``track`` took never gets its force (lost in real time): its power is not
+        booked, as for a sample skipped whole."""
+        self._unbooked = None
+
+    def message(self, stamp_ns: int, position: Vec3, velocity: Vec3, force: Force) -> PortMessage:
+        """Sample k's message to the master, after ``track``: its point (m), velocity (m/s)
+        and contact force (N), the port's energy book with the sample's power in it."""
+        if self._unbooked is not None:  # the controller was off: the velocity went out as is
+            self.port.admittance(self._unbooked, force)
+            self._unbooked = None
         o = self.origin
+        assert o is not None
         disp = (position[0] - o[0], position[1] - o[1], position[2] - o[2])
-        return self.target, self._message(stamp_ns, disp, velocity, force)
+        return self._message(stamp_ns, disp, velocity, force)

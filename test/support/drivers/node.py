@@ -157,18 +157,20 @@ class DriverNode(LoopNode):
     def _tick(self, now: float, publish: bool) -> None:
         """The cycle at grid instant ``self._n`` (deadline ``self.deadline``), processed at
         monotonic ``now``: first the commands DDS received before that instant (``Inbox``: a
-        real driver's update does not wait for a late Python tick), then the plant over the
-        period before it with the effort in force (ros2_control: the command written at the
-        tick before; Touch: the newest force), its state out (``publish``), the controller's
-        update. A tick processed late first catches up the ticks already due, their states
-        going out at once, stamped their instants (``CATCH_UP`` at most: then the grid moves
-        on and states are lost)."""
+        real driver's update does not wait for a late Python tick), then the state at the
+        instant out (``publish``), the controller's update. ros2_control (fd, arm): the plant
+        already stepped over the period before the instant at the end of the last tick, with
+        the command written then, as the device moves on its own while the driver waits; then
+        it steps over the next period with this update's command. Touch: the newest force acts
+        over the period before the instant, so the plant steps then. A tick processed late
+        first catches up the ticks already due, their states going out at once, stamped their
+        instants (``CATCH_UP`` at most: then the grid moves on and states are lost)."""
         stamp = self._t0_ns + self._n * self.period_ns
         self.io.receive(stamp)  # the stamp is the tick's instant on the system clock
-        if self._k >= 0:
-            if self._answered != self._stamp and self.on_time and self._marked != self._stamp:
-                self._unanswered += 1
-                self._marked = self._stamp
+        if self._k >= 0 and self.on_time and self._stamp not in (self._answered, self._marked):
+            self._unanswered += 1
+            self._marked = self._stamp
+        if self.kind == "touch" and self._k >= 0:
             effort = self._effort()
             self._resting = self._resting and not any(self._force)
             if not self._resting:
@@ -190,6 +192,8 @@ class DriverNode(LoopNode):
         self._n += 1
         self.deadline += self.period_s
         self.plant.prepare()
+        if self.kind != "touch":  # the period to the next instant, ahead of it
+            self.plant.apply(self._effort())
 
     def _publish(self, stamp: int, s: Any) -> None:
         self._stamp = stamp

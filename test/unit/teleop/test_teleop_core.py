@@ -330,3 +330,30 @@ def test_the_ends_count_samples_of_system_clock_stamps_as_of_lockstep_stamps() -
         runs.append(out)
     assert runs[0] == runs[1]
     assert runs[1][40][2] is False and runs[1][99][2] is True  # the cut (50) came, at its sample
+
+
+@pytest.mark.parametrize("passivity", [False, True])
+def test_the_slaves_point_tracked_before_its_force_is_the_whole_cycles(passivity: bool) -> None:
+    """The slave's end in two steps (``track`` on the sample's point, then ``message`` once the
+    force is here: what the channel node does, so the slave's command does not wait for its
+    estimate) gives the one-step cycle's point, messages and energy book exactly, through an
+    outage; with the passivity controller on, the point needs the force."""
+    rng = np.random.default_rng(3)
+    master, whole = ends(round_trip_delay_ms=2.0, timeout_s=0.005, passivity=passivity)
+    _, split = ends(round_trip_delay_ms=2.0, timeout_s=0.005, passivity=passivity)
+    for k in range(120):
+        here = tuple(float(x) for x in rng.normal(0.0, 0.01, 3) + np.array([0.5, 0.0, 0.4]))
+        velocity, force = tuple(rng.normal(0.0, 0.1, 3)), tuple(rng.normal(0.0, 5.0, 3))
+        _, to_slave = master.cycle(k * PERIOD, (0.001 * k, 0.0, 0.0), (1.0, 0.0, 0.0))
+        target, to_master = whole.cycle(k * PERIOD, here, velocity, force)
+        if passivity:
+            with pytest.raises(ValueError, match="needs the sample's force"):
+                split.track(k * PERIOD, here)
+        assert split.track(k * PERIOD, here, None if not passivity else force) == target
+        assert split.message(k * PERIOD, here, velocity, force) == to_master
+        if not 60 <= k < 80:
+            for end in (whole, split):
+                end.receive(to_slave)
+            master.receive(to_master)
+    assert split.port.e_in == whole.port.e_in > 0.0 and split.port.e_out == whole.port.e_out
+    assert (whole.port.dissipated_j > 0.0) == passivity
