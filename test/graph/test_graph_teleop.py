@@ -1,7 +1,7 @@
 """The teleoperation graph in lockstep (haptic-launch teleop_sim): the master's and the slave's
 nodes in /master and /slave, composed in one process (the default) or one process each,
 reproduce the batch run bit for bit, through a channel with delay, jitter and passivity control,
-or without it (the slave's point to track then goes out before its force estimate is made)."""
+or without it."""
 
 from __future__ import annotations
 

@@ -288,10 +288,11 @@ def test_composed_in_ol_the_command_goes_out_before_the_observer_works(monkeypat
 def test_composed_the_slaves_command_goes_out_before_its_estimate_is_made(
     monkeypatch, passivity: bool
 ) -> None:
-    """A teleoperation slave (the 7-DOF arm's URDF) composed: its channel end, its controller
-    and its observer. Without the passivity controller, the point to track needs no force, so
-    command k goes out before the observer's estimate k is made, and the message to the master
-    after it; with the controller on, the point waits for the estimate."""
+    """A teleoperation slave (the 7-DOF arm's URDF) composed in real time: its channel end, its
+    controller and its observer. Without the passivity controller, the point to track needs no
+    force, so command k goes out before the observer's estimate k is made, and the message to
+    the master after it; with the controller on, the point waits for the estimate. A force
+    newer than the newest point answers nothing again."""
     from rclpy.node import Node
 
     from haptic_msgs_py import codecs
@@ -330,6 +331,7 @@ def test_composed_the_slaves_command_goes_out_before_its_estimate_is_made(
     p_js = LoopPublisher(device, JOINT_STATES, codecs.JOINT_STATE, qos.LOOP, "world")
     p_pose = LoopPublisher(device, EE_POSE, codecs.POSE, qos.LOOP, "world")
     p_twist = LoopPublisher(device, EE_TWIST, codecs.TWIST, qos.LOOP, "world")
+    p_force = LoopPublisher(device, WRENCH_ESTIMATE, codecs.WRENCH, qos.LOOP, "world")
     names = tuple(obs.model.joint_names)
     q = (0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8)
     tip = tuple(float(x) for x in obs.model.forward_kinematics(q))
@@ -345,6 +347,8 @@ def test_composed_the_slaves_command_goes_out_before_its_estimate_is_made(
             else [WRENCH_ESTIMATE, POSE_DESIRED, EFFORT_COMMAND]
         )
         assert log == [(t, s) for s in stamps for t in order], log
+        p_force.publish(StampedVector(stamps[-1] + 1_000_000, (0.0, 0.0, 0.0)))
+        assert log[-1] == (WRENCH_ESTIMATE, stamps[-1] + 1_000_000)  # and nothing after it
     finally:
         for n in (device, ctl, chan, obs):
             n.destroy_node()

@@ -220,9 +220,9 @@ class CommandAuthority:
     ) -> None:
         """Name the publishers the graph listed since a refusal found some unlisted. One that
         left unlisted, or is still unlisted after ``NAME_GRACE_S``, is said not to be named."""
+        found = found or bool(self._outside - known)  # listed since (the source's too)
         for e in self.strangers:
             if e.gid not in known and e.gid not in self.named and e.gid not in self._pending:
-                found = True
                 if e.node:
                     self._say(e, taking)
                 else:

@@ -158,8 +158,8 @@ class ChannelNode(LoopNode):
         self._step(sample=True)
 
     def _on_force(self, force: StampedVector) -> None:
-        self._force = force
-        self._step(sample=True)
+        self._force = force  # a newer force than the sample's is not the sample again
+        self._step(sample=self._pose is not None and force.stamp_ns == self._pose.stamp_ns)
 
     def _on_link(self, js: JointSample) -> None:
         self.end.receive(from_wire(js))
@@ -167,13 +167,20 @@ class ChannelNode(LoopNode):
 
     # --- the cycle -------------------------------------------------------------------------
     def _step(self, sample: bool) -> None:
-        """Answer the newest sample once its inputs (and, in lockstep, the peer's) are here. The
-        slave's point to track goes out on its point alone unless the passivity controller
-        needs the force (its controller's command then does not wait for the estimate), and its
-        message to the master once the force came (``_finish``)."""
+        """Answer the newest sample once its inputs (and, in lockstep, the peer's) are here. In
+        real time the slave's point to track goes out on its point alone unless the passivity
+        controller needs the force (its controller's command then does not wait for the
+        estimate), and its message to the master once the force came (``_finish``); in
+        lockstep both wait for the force, so a lost estimate is made again for a re-sent
+        sample."""
         tracked = self._tracked  # a sample awaiting its force goes first
-        if tracked is not None and not (self._finish(tracked) and self._newer(tracked[0])):
-            return
+        if tracked is not None:
+            if not self._finish(tracked):
+                if sample and self._pose is not None and self._pose.stamp_ns == tracked[0]:
+                    self._out.publish(self._answer)  # the same sample again: the same answer
+                return
+            if not self._newer(tracked[0]):
+                return
         pose, twist = self._pose, self._twist
         if pose is None or twist is None or pose.stamp_ns != twist.stamp_ns:
             return
@@ -191,7 +198,7 @@ class ChannelNode(LoopNode):
             self._send(k, message)
             return
         force = self._force.vector if self._force and self._force.stamp_ns == k else None
-        if force is None and end.target_needs_force:
+        if force is None and (end.target_needs_force or self.wait):
             return
         self._answer_with(k, end.track(k, pose.vector, force))
         self._tracked = (k, pose.vector, twist.vector)

@@ -248,7 +248,9 @@ class SlaveEnd(_End):
 
     def forget(self) -> None:
         """The sample ``track`` took never gets its force (lost in real time): its power is not
-        booked, as for a sample skipped whole."""
+        booked, as for a sample skipped whole, though its target moved (only without the
+        passivity controller, which would have needed the force: the book is then an
+        observer's)."""
         self._unbooked = None
 
     def message(self, stamp_ns: int, position: Vec3, velocity: Vec3, force: Force) -> PortMessage:

@@ -212,3 +212,23 @@ def test_a_publisher_that_the_graph_never_lists_is_said_once_as_unnamed(leaves: 
     assert len(warned) == 2 and "does not tell apart by name" in warned[-1]
     a.follow_up()
     assert len(warned) == 2
+
+
+def test_a_source_matched_before_the_graph_lists_it_says_nothing_generic() -> None:
+    """The loop's controller restarts while a named stray goes on: its new endpoint is matched
+    before the graph lists it, and a refusal of the stray's comes meanwhile. Once the graph
+    lists the controller, nothing is left unnamed: no generic line."""
+    graph = FakeGraph(CTL, STRAY)
+    a, warned, _, clock = authority(graph, token="s3cret")
+    a.admit("")
+    assert len(warned) == 1
+    graph.endpoints.remove(CTL)
+    graph.hidden = 1  # the restarted controller, matched, not listed yet
+    clock.t += LOOK_AGAIN_S
+    a.admit("")
+    graph.hidden = 0
+    graph.endpoints.append(Endpoint(SOURCE, "01.cc"))
+    a.follow_up()
+    clock.t += NAME_GRACE_S
+    a.follow_up()
+    assert len(warned) == 1 and a.refused == 2
