@@ -202,13 +202,7 @@ class CommandAuthority:
     def _name(self, taking: bool) -> None:
         """Say each publisher a command was refused (or, open, taken) from, once; one the graph
         knows by its GID alone waits for ``follow_up``."""
-        for e in self.strangers:
-            if e.gid in self.named or e.gid in self._pending:
-                continue
-            if e.node:
-                self._say(e, taking)
-            else:
-                self._pending[e.gid] = (self._clock(), taking)
+        self._name_each(self.strangers, self._clock(), taking)
         if self._unlisted > 0:  # the sender may be one the graph does not list yet
             if self._awaiting is None:
                 self._awaiting = (self._clock(), taking, self._outside, False)
@@ -221,16 +215,22 @@ class CommandAuthority:
         """Name the publishers the graph listed since a refusal found some unlisted. One that
         left unlisted, or is still unlisted after ``NAME_GRACE_S``, is said not to be named."""
         found = found or bool(self._outside - known)  # listed since (the source's too)
-        for e in self.strangers:
-            if e.gid not in known and e.gid not in self.named and e.gid not in self._pending:
-                if e.node:
-                    self._say(e, taking)
-                else:
-                    self._pending[e.gid] = (first, taking)
+        self._name_each([e for e in self.strangers if e.gid not in known], first, taking)
         done = self._unlisted == 0 or now - first >= NAME_GRACE_S
         self._awaiting = None if done else (first, taking, known, found)
         if done and not taking and (self._unlisted > 0 or not found):
             self._say_unnamed()
+
+    def _name_each(self, endpoints: Sequence[Endpoint], first: float, taking: bool) -> None:
+        """Say each of ``endpoints`` not said yet; one known by its GID alone waits, from
+        ``first``, for ``follow_up``."""
+        for e in endpoints:
+            if e.gid in self.named or e.gid in self._pending:
+                continue
+            if e.node:
+                self._say(e, taking)
+            else:
+                self._pending[e.gid] = (first, taking)
 
     def _say_unnamed(self) -> None:
         """Say once (per change of the graph's publishers) that a refused command's publisher
