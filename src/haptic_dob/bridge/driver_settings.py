@@ -126,6 +126,26 @@ class StateSettings:
             bounds=(0.0, 1e5),
         ),
     )
+    encoder_resolution: list[float] | tuple[float, ...] = field(
+        default_factory=lambda: [0.0],
+        metadata=param(
+            description="each joint's position count (rad or m; one for all); 0 = low-pass",
+            bounds=(0.0, 1.0),
+            details=(
+                "Set (> 0) for a differenced velocity by adaptive windowing: the slope of the "
+                "least-squares line through the longest run of recent positions (at most "
+                "velocity_window_samples periods) closer than half a count to it, in place of "
+                "the low-pass. For coarse encoders (a Touch's joints: about 4e-4 rad)."
+            ),
+        ),
+    )
+    velocity_window_samples: int = field(
+        default=8,
+        metadata=param(
+            description="the adaptive window's longest span, in driver periods",
+            bounds=(1, 64),
+        ),
+    )
     effort: str = field(
         default="",
         metadata=param(

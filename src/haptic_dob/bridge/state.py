@@ -4,9 +4,9 @@
 the model's q and q' (and the driver's effort, where it reports one): joints matched by name in
 any order with extra joints ignored (``core.joint_states.JointMap``), each multiplied by its sign
 and the unit scale; a pose's axes permuted and signed (``frame.*``). Velocity is the driver's
-where it gives one and the settings take it, else the backward difference of the positions over
-the stamps' interval, low-passed (``VelocityFilter``). Anything unusable raises ``ValueError``
-naming it; nothing is kept from a refused message.
+where it gives one and the settings take it, else differenced from the positions
+(``bridge.velocity``: low-passed, or by an adaptive window for coarse counts). Anything unusable
+raises ``ValueError`` naming it; nothing is kept from a refused message.
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ import numpy as np
 
 from haptic_dob.bridge.driver_settings import FrameSettings, StateSettings
 from haptic_dob.bridge.settings import per_element
+from haptic_dob.bridge.velocity import Velocity, VelocityFilter, WindowVelocity
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.base import DeviceModel
-from haptic_msgs_py.stamps import NS_PER_S
 
 
 class DriverState(NamedTuple):
@@ -34,37 +34,15 @@ class DriverState(NamedTuple):
     effort: tuple[float, ...] | None
 
 
-class VelocityFilter:
-    """Backward difference of positions over the stamps' interval, then a first-order low-pass
-    (``alpha = 1 - exp(-2 pi fc dt)``; ``fc = 0``: unfiltered). The first sample's velocity is
-    zero; an interval <= 0 or over ``max_gap_s`` restarts the filter from that sample."""
-
-    def __init__(self, cutoff_hz: float, max_gap_s: float) -> None:
-        self.cutoff_hz = cutoff_hz
-        self.max_gap_s = max_gap_s
-        self._q: tuple[float, ...] | None = None
-        self._stamp = 0
-        self._v: list[float] = []
-
-    def update(self, stamp_ns: int, q: Sequence[float]) -> tuple[float, ...]:
-        """The velocity (per s) at sample ``stamp_ns`` with positions ``q``."""
-        prev, self._q = self._q, tuple(q)
-        dt = (stamp_ns - self._stamp) / NS_PER_S
-        self._stamp = stamp_ns
-        if prev is None or not 0.0 < dt <= self.max_gap_s:
-            self._v = [0.0] * len(q)
-            return tuple(self._v)
-        raw = [(a - b) / dt for a, b in zip(q, prev, strict=True)]
-        if self.cutoff_hz <= 0.0:
-            self._v = raw
-        else:
-            alpha = 1.0 - math.exp(-2.0 * math.pi * self.cutoff_hz * dt)
-            self._v = [v + alpha * (r - v) for v, r in zip(self._v, raw, strict=True)]
-        return tuple(self._v)
-
-    def reset(self) -> None:
-        """Forget the history: the next sample starts again from zero velocity."""
-        self._q = None
+def velocity_estimator(state: StateSettings, n: int, max_gap_s: float) -> Velocity:
+    """The settings' estimator of a differenced velocity for ``n`` joints: the adaptive window
+    where ``state.encoder_resolution`` is set, else the low-pass."""
+    counts = per_element("state.encoder_resolution", state.encoder_resolution, n, positive=False)
+    if not any(counts):
+        return VelocityFilter(state.velocity_cutoff_hz, max_gap_s)
+    if not all(c > 0.0 for c in counts):
+        raise ValueError(f"state.encoder_resolution: set every joint's (> 0) or none, got {counts}")
+    return WindowVelocity(counts, state.velocity_window_samples, max_gap_s)
 
 
 def check_cartesian(model: DeviceModel) -> None:
@@ -111,7 +89,7 @@ class StateReader:
         self.axis_signs = tuple(frame.signs)
         self._map = JointMap(self.driver_joints)
         self._gain = [s * self.scale for s in self.signs]
-        self.velocity = VelocityFilter(state.velocity_cutoff_hz, 5.0 * period_s)
+        self.velocity = velocity_estimator(state, n, 5.0 * period_s)
 
     def joints(
         self, stamp_ns: int, names: Sequence[str], position: Any, velocity: Any, effort: Any

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from haptic_dob.bridge.driver_settings import FrameSettings, StateSettings
-from haptic_dob.bridge.state import StateReader, VelocityFilter
+from haptic_dob.bridge.state import StateReader
+from haptic_dob.bridge.velocity import VelocityFilter
 
 MODEL = ("phi1", "phi2", "phi3")
 TOUCH = ("waist", "shoulder", "elbow", "yaw", "pitch", "roll")
