@@ -90,6 +90,7 @@ class StateReader:
         self._map = JointMap(self.driver_joints)
         self._gain = [s * self.scale for s in self.signs]
         self.velocity = velocity_estimator(state, n, 5.0 * period_s)
+        self._said_finer: set[int] = set()
 
     def joints(
         self, stamp_ns: int, names: Sequence[str], position: Any, velocity: Any, effort: Any
@@ -117,6 +118,23 @@ class StateReader:
         if not given:
             qd = self.velocity.update(stamp_ns, q)
         return DriverState(stamp_ns, q, qd, tau)
+
+    def count_warnings(self) -> list[str]:
+        """A line for each joint newly seen to step by less than half its
+        ``state.encoder_resolution`` (a count set too coarse makes the velocity lag)."""
+        v = self.velocity
+        if not isinstance(v, WindowVelocity) or len(v.finer) == len(self._said_finer):
+            return []
+        lines = []
+        for j, step in sorted(v.finer.items()):
+            if j not in self._said_finer:
+                self._said_finer.add(j)
+                lines.append(
+                    f"state.encoder_resolution: {self.driver_joints[j]} stepped {step:.3g} between "
+                    f"two states, under half its count ({2.0 * v.half[j]:.3g}): set the count "
+                    "it has, the smallest step it takes (too coarse, the velocity lags)"
+                )
+        return lines
 
     def position(self, stamp_ns: int, xyz: Sequence[float]) -> DriverState:
         """A pose's position (driver axes) as the Cartesian model's q; q' differenced."""

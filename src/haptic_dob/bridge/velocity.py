@@ -79,6 +79,8 @@ class WindowVelocity:
         self.max_gap_s = max_gap_s
         self._t: deque[float] = deque(maxlen=max_samples + 1)  # newest first (s)
         self._q: deque[tuple[float, ...]] = deque(maxlen=max_samples + 1)
+        #: per joint, the first step seen under half its count (the count set too coarse)
+        self.finer: dict[int, float] = {}
 
     def update(self, stamp_ns: int, q: Sequence[float]) -> tuple[float, ...]:
         """The velocity (per s) at sample ``stamp_ns`` with positions ``q``."""
@@ -89,6 +91,9 @@ class WindowVelocity:
         self._q.appendleft(tuple(q))
         if len(self._t) < 2:
             return (0.0,) * len(q)
+        for j, (a, b) in enumerate(zip(self._q[0], self._q[1], strict=True)):
+            if 0.0 < abs(a - b) < self.half[j] and j not in self.finer:
+                self.finer[j] = abs(a - b)
         tau = [s - t for s in self._t]  # <= 0, newest first
         return tuple(_slope(tau, [p[j] for p in self._q], h) for j, h in enumerate(self.half))
 

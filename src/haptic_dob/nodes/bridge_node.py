@@ -185,8 +185,8 @@ class BridgeNode(LoopNode):
         self._p_ext.publish(JointSample(js.stamp_ns, self.reader.driver_joints, (), (), effort))
 
     def _say(self) -> None:
-        """What the loop said during the cycle, once its command is out."""
-        news, self._news[:] = list(self._news), []
+        """What the loop and the state reader said during the cycle, once its command is out."""
+        news, self._news[:] = [*self._news, *self.reader.count_warnings()], []
         for line in news:
             self.log.warning(line)
 
