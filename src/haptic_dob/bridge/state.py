@@ -123,7 +123,7 @@ class StateReader:
         """A line for each joint newly seen to step by less than half its
         ``state.encoder_resolution`` (a count set too coarse makes the velocity lag)."""
         v = self.velocity
-        if not isinstance(v, WindowVelocity) or len(v.finer) == len(self._said_finer):
+        if not isinstance(v, WindowVelocity) or len(v.check_step()) == len(self._said_finer):
             return []
         lines = []
         for j, step in sorted(v.finer.items()):

@@ -91,11 +91,17 @@ class WindowVelocity:
         self._q.appendleft(tuple(q))
         if len(self._t) < 2:
             return (0.0,) * len(q)
-        for j, (a, b) in enumerate(zip(self._q[0], self._q[1], strict=True)):
-            if 0.0 < abs(a - b) < self.half[j] and j not in self.finer:
-                self.finer[j] = abs(a - b)
         tau = [s - t for s in self._t]  # <= 0, newest first
         return tuple(_slope(tau, [p[j] for p in self._q], h) for j, h in enumerate(self.half))
+
+    def check_step(self) -> dict[int, float]:
+        """Note each joint whose newest step is under half its count (called off the
+        command's path); returns ``finer``: per joint, the first such step."""
+        if len(self._q) >= 2:
+            for j, (a, b) in enumerate(zip(self._q[0], self._q[1], strict=True)):
+                if 0.0 < abs(a - b) < self.half[j] and j not in self.finer:
+                    self.finer[j] = abs(a - b)
+        return self.finer
 
     def reset(self) -> None:
         """Forget the history: the next sample starts again from zero velocity."""
