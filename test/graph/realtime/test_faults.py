@@ -4,7 +4,10 @@ The node to kill runs in its own process, the rest of the loop composed in anoth
 through the ros2 run contract, not the launcher, so one can be killed): a loop of two processes.
 The test measures, on the device's own sample clock, how long after the last command the applied
 effort (``joint_states.effort``) reaches zero, reads why from ``/diagnostics``, restarts the node
-and sees the force come back.
+and sees the force come back. A restarted node that stays deaf to the others while the force stays
+zero (Fast DDS's shared memory after a kill -9: 2 in 103 restarts beside a CPU hog;
+docs/safety.md) is an xfail that says so, told apart from a failure of the suite's by
+``heard_nothing``.
 """
 
 from __future__ import annotations
@@ -198,6 +201,10 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
 
         if not wait_until(resumed, 40, poll_s=0.2):
             _, _, e = efforts()
+            # the force held at zero all along, and the restarted node deaf: xfail, with why
+            deaf = "" if np.any(e[-HELD_ZERO:]) else heard_nothing(col, victim, t_restart)
+            if deaf:
+                pytest.xfail(deaf)
             pytest.fail(
                 f"the loop did not resume after restarting {victim} ({e.size} samples, the last "
                 f"efforts {e[-5:]}); {victim}: {procs[victim].output()[-1500:]}; the rest: "
@@ -212,6 +219,43 @@ def test_kill_9_zeroes_the_force_within_the_command_timeout(
     finally:
         stop_all(procs)
         col.close()
+
+
+#: what each victim's cycle needs from the others: the node that publishes it, and the input
+INPUTS = {
+    "controller_node": ("environment_node", "wrench_desired"),
+    "observer_node": ("device_node", "joint_states"),
+    "environment_node": ("device_node", "ee_pose"),
+}
+
+
+def heard_nothing(col: Collector, victim: str, since: float) -> str:
+    """Why the restarted ``victim`` did not close the loop, when it is the middleware's known
+    fault and not the suite's (else ''): alive on DDS (its /diagnostics reach this process), the
+    node publishing its input cycling (so publishing it), and yet the victim ran not one cycle in
+    20 s. Fast DDS 2.14's shared-memory transport can leave a restarted participant deaf to the
+    survivors of a kill -9 whose port it took again (eProsima/Fast-DDS#5053; docs/safety.md)."""
+    from haptic_msgs_py.wire import decoder
+
+    decode = decoder("diagnostic_msgs/msg/DiagnosticArray")
+    with col._lock:
+        diags = [b for t, b in col.records[DIAGNOSTICS] if t > since + 20.0]
+    rates: dict[str, list[float]] = {}
+    for b in diags:
+        for st in decode(b).status:
+            for v in st.values:
+                if v.key == "loop_rate_hz":
+                    rates.setdefault(st.name.lstrip("/"), []).append(float(v.value))
+    source, topic = INPUTS[victim]
+    mine, theirs = rates.get(victim, []), rates.get(source, [])
+    if len(mine) < 5 or any(mine) or len(theirs) < 5 or min(theirs) < 100.0:
+        return ""
+    return (
+        f"the restarted {victim} is on DDS ({len(mine)} reports in its last 20 s) and "
+        f"{source} publishes its {topic} ({min(theirs):.0f}-{max(theirs):.0f} Hz), but it ran "
+        "no cycle: Fast DDS's shared memory after a kill -9 (eProsima/Fast-DDS#5053; "
+        "docs/safety.md)"
+    )
 
 
 def wait_for_effort(efforts: Efforts, since: float, n: int, timeout: float) -> bool:
