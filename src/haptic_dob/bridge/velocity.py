@@ -77,21 +77,22 @@ class WindowVelocity:
         # rounded count can be, is out whatever the float rounding of its distance)
         self.half = tuple(0.5 * float(r) * (1.0 - 1e-9) for r in resolution)
         self.max_gap_s = max_gap_s
-        self._t: deque[float] = deque(maxlen=max_samples + 1)  # newest first (s)
+        self._t: deque[int] = deque(maxlen=max_samples + 1)  # stamps (ns), newest first
         self._q: deque[tuple[float, ...]] = deque(maxlen=max_samples + 1)
         #: per joint, the first step seen under half its count (the count set too coarse)
         self.finer: dict[int, float] = {}
 
     def update(self, stamp_ns: int, q: Sequence[float]) -> tuple[float, ...]:
         """The velocity (per s) at sample ``stamp_ns`` with positions ``q``."""
-        t = stamp_ns / NS_PER_S
-        if self._t and not 0.0 < t - self._t[0] <= self.max_gap_s:
+        if self._t and not 0.0 < (stamp_ns - self._t[0]) / NS_PER_S <= self.max_gap_s:
             self.reset()
-        self._t.appendleft(t)
+        self._t.appendleft(stamp_ns)
         self._q.appendleft(tuple(q))
         if len(self._t) < 2:
             return (0.0,) * len(q)
-        tau = [s - t for s in self._t]  # <= 0, newest first
+        # seconds before this sample, from whole nanoseconds (a wall clock's stamps as float
+        # seconds would keep their differences to 0.2 us only)
+        tau = [(s - stamp_ns) / NS_PER_S for s in self._t]  # <= 0, newest first
         return tuple(_slope(tau, [p[j] for p in self._q], h) for j, h in enumerate(self.half))
 
     def check_step(self) -> dict[int, float]:
