@@ -5,7 +5,7 @@ through the ros2 run contract, not the launcher, so one can be killed): a loop o
 The test measures, on the device's own sample clock, how long after the last command the applied
 effort (``joint_states.effort``) reaches zero, reads why from ``/diagnostics``, restarts the node
 and sees the force come back. A restarted node that stays deaf to the others while the force stays
-zero (Fast DDS's shared memory after a kill -9: 2 in 103 restarts beside a CPU hog;
+zero (Fast DDS's shared memory after a kill -9: 2 in 102 restarts beside a CPU hog;
 docs/safety.md) is an xfail that says so, told apart from a failure of the suite's by
 ``heard_nothing``.
 """
