@@ -135,7 +135,9 @@ class StateSettings:
                 "Set (> 0) for a differenced velocity by adaptive windowing: the slope of the "
                 "least-squares line through the longest run of recent positions (at most "
                 "velocity_window_samples periods) closer than half a count to it, in place of "
-                "the low-pass. For coarse encoders (a Touch's joints: about 4e-4 rad)."
+                "the low-pass. For coarse encoders (a Touch's joints: about 4e-4 rad). In the "
+                "model's units (after scale); a joint published as the difference of two "
+                "encoders' angles lies up to a whole count off: give it two."
             ),
         ),
     )

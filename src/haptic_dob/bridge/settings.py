@@ -187,15 +187,18 @@ def bridge_specs() -> list[ParamSpec]:
     ]
 
 
-def per_element(name: str, values: Sequence[float], n: int, positive: bool) -> tuple[float, ...]:
-    """One value for every one of ``n`` elements, or one each (``ValueError`` otherwise)."""
+def per_element(
+    name: str, values: Sequence[float], n: int, positive: bool, of: str = "command element"
+) -> tuple[float, ...]:
+    """One value for every one of ``n`` elements (each ``of``), or one each (``ValueError``
+    otherwise)."""
     vals = tuple(float(v) for v in values)
     if len(vals) == 1:
         vals = vals * n
     if not vals:
-        raise ValueError(f"{name}: set it (one value, or one per command element); [] is none")
+        raise ValueError(f"{name}: set it (one value, or one per {of}); [] is none")
     if len(vals) != n:
-        raise ValueError(f"{name} needs 1 or {n} values (one per command element), got {len(vals)}")
+        raise ValueError(f"{name} needs 1 or {n} values (one per {of}), got {len(vals)}")
     if positive and not all(v > 0.0 for v in vals):
         raise ValueError(f"{name} must be > 0, got {list(vals)}")
     return vals

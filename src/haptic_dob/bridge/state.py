@@ -37,11 +37,18 @@ class DriverState(NamedTuple):
 def velocity_estimator(state: StateSettings, n: int, max_gap_s: float) -> Velocity:
     """The settings' estimator of a differenced velocity for ``n`` joints: the adaptive window
     where ``state.encoder_resolution`` is set, else the low-pass."""
-    counts = per_element("state.encoder_resolution", state.encoder_resolution, n, positive=False)
+    counts = per_element(
+        "state.encoder_resolution", state.encoder_resolution, n, positive=False, of="joint"
+    )
+    if not all(math.isfinite(c) and c >= 0.0 for c in counts):
+        raise ValueError(f"state.encoder_resolution must be >= 0 (0: the low-pass), got {counts}")
     if not any(counts):
         return VelocityFilter(state.velocity_cutoff_hz, max_gap_s)
-    if not all(c > 0.0 for c in counts):
-        raise ValueError(f"state.encoder_resolution: set every joint's (> 0) or none, got {counts}")
+    if not all(counts):
+        raise ValueError(
+            f"state.encoder_resolution: set every joint's (> 0) or none (0: the low-pass), got "
+            f"{list(counts)}"
+        )
     return WindowVelocity(counts, state.velocity_window_samples, max_gap_s)
 
 
@@ -121,9 +128,12 @@ class StateReader:
 
     def count_warnings(self) -> list[str]:
         """A line for each joint newly seen to step by less than half its
-        ``state.encoder_resolution`` (a count set too coarse makes the velocity lag)."""
+        ``state.encoder_resolution`` (a count set too coarse makes the velocity lag; up to twice
+        the true count passes unsaid). None for a pose state."""
         v = self.velocity
-        if not isinstance(v, WindowVelocity) or len(v.check_step()) == len(self._said_finer):
+        if self.pose or not isinstance(v, WindowVelocity):
+            return []  # a pose's axes come through kinematics: their steps are no counts
+        if len(v.check_step()) == len(self._said_finer):
             return []
         lines = []
         for j, step in sorted(v.finer.items()):

@@ -75,7 +75,25 @@ def test_a_gap_or_a_repeated_stamp_starts_again() -> None:
     assert w.update(5 * T_NS, (0.005,))[0] == pytest.approx(0.5)
     assert w.update(5 * T_NS, (0.006,)) == (0.0,)  # the same stamp: from zero
     assert w.update(6 * T_NS, (0.007,))[0] == pytest.approx(0.5)
-    assert w.update(6 * T_NS + 20_000_000, (0.0,)) == (0.0,)  # 20 ms gap past max_gap_s
+    t = 6 * T_NS + 20_000_000
+    assert w.update(t, (0.0,)) == (0.0,)  # 20 ms gap past max_gap_s
+    assert w.update(t + T_NS, (0.0,)) == (0.0,)  # nothing from before the gap is kept
+
+
+def test_the_band_is_half_each_joints_count_and_the_window_its_whole_length() -> None:
+    """Joint a (count 1e-3): samples 0, 0, 0, 1e-3, newest last. The 3-sample line leaves them
+    1/6, 1/3, 1/6 of a count off, the 4-sample line 0.2, 0.1, 0.4, 0.3: both inside half, so
+    the slope is the 4-sample one, 0.3 counts a period. Joint b, the same positions with a count
+    of 5e-4: the 3-sample line is out already, so the backward difference, 1e-3 a period. With
+    at most 2 intervals, joint a's window is the 3-sample one (0.5e-3 a period)."""
+    up = [(0.0, 0.0), (0.0, 0.0), (0.0, 0.0), (1e-3, 1e-3)]
+    w = WindowVelocity([1e-3, 5e-4], 3, 0.01)
+    got = [w.update(k * T_NS, q) for k, q in enumerate(up)][-1]
+    period = T_NS * 1e-9
+    assert got[0] == pytest.approx(0.3e-3 / period) and got[1] == pytest.approx(1e-3 / period)
+    w2 = WindowVelocity([1e-3], 2, 0.01)
+    got2 = [w2.update(k * T_NS, (q[0],)) for k, q in enumerate(up)][-1]
+    assert got2[0] == pytest.approx(0.5e-3 / period)
 
 
 def reader(**state: object) -> StateReader:
