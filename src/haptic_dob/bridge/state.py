@@ -97,7 +97,6 @@ class StateReader:
         self._map = JointMap(self.driver_joints)
         self._gain = [s * self.scale for s in self.signs]
         self.velocity = velocity_estimator(state, n, 5.0 * period_s)
-        self._said_finer: set[int] = set()
 
     def joints(
         self, stamp_ns: int, names: Sequence[str], position: Any, velocity: Any, effort: Any
@@ -133,18 +132,12 @@ class StateReader:
         v = self.velocity
         if self.pose or not isinstance(v, WindowVelocity):
             return []  # a pose's axes come through kinematics: their steps are no counts
-        if len(v.check_step()) == len(self._said_finer):
-            return []
-        lines = []
-        for j, step in sorted(v.finer.items()):
-            if j not in self._said_finer:
-                self._said_finer.add(j)
-                lines.append(
-                    f"state.encoder_resolution: {self.driver_joints[j]} stepped {step:.3g} between "
-                    f"two states, under half its count ({2.0 * v.half[j]:.3g}): set the count "
-                    "it has, the smallest step it takes (too coarse, the velocity lags)"
-                )
-        return lines
+        return [
+            f"state.encoder_resolution: {self.driver_joints[j]} stepped {step:.3g} between two "
+            f"states, under half its count ({2.0 * v.half[j]:.3g}): set the count it has, the "
+            "smallest step it takes (too coarse, the velocity lags)"
+            for j, step in sorted(v.finer_steps().items())
+        ]
 
     def position(self, stamp_ns: int, xyz: Sequence[float]) -> DriverState:
         """A pose's position (driver axes) as the Cartesian model's q; q' differenced."""

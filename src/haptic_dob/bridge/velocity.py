@@ -79,8 +79,7 @@ class WindowVelocity:
         self.max_gap_s = max_gap_s
         self._t: deque[int] = deque(maxlen=max_samples + 1)  # stamps (ns), newest first
         self._q: deque[tuple[float, ...]] = deque(maxlen=max_samples + 1)
-        #: per joint, the first step seen under half its count (the count set too coarse)
-        self.finer: dict[int, float] = {}
+        self._finer: set[int] = set()  # the joints seen to step under half their count
 
     def update(self, stamp_ns: int, q: Sequence[float]) -> tuple[float, ...]:
         """The velocity (per s) at sample ``stamp_ns`` with positions ``q``."""
@@ -95,14 +94,16 @@ class WindowVelocity:
         tau = [(s - stamp_ns) / NS_PER_S for s in self._t]  # <= 0, newest first
         return tuple(_slope(tau, [p[j] for p in self._q], h) for j, h in enumerate(self.half))
 
-    def check_step(self) -> dict[int, float]:
-        """Note each joint whose newest step is under half its count (called off the
-        command's path); returns ``finer``: per joint, the first such step."""
+    def finer_steps(self) -> dict[int, float]:
+        """The joints whose newest step is under half their count, each once ever, with that
+        step (called off the command's path)."""
+        new: dict[int, float] = {}
         if len(self._q) >= 2:
             for j, (a, b) in enumerate(zip(self._q[0], self._q[1], strict=True)):
-                if 0.0 < abs(a - b) < self.half[j] and j not in self.finer:
-                    self.finer[j] = abs(a - b)
-        return self.finer
+                if 0.0 < abs(a - b) < self.half[j] and j not in self._finer:
+                    self._finer.add(j)
+                    new[j] = abs(a - b)
+        return new
 
     def reset(self) -> None:
         """Forget the history: the next sample starts again from zero velocity."""
