@@ -62,6 +62,29 @@ def test_encoder_quantizes_and_velocity_is_the_backward_difference() -> None:
     np.testing.assert_array_equal(exact.sample().qd, exact.v)
 
 
+def test_encoder_matrix_counts_a_joint_as_a_difference_of_two_encoders() -> None:
+    """A Touch's elbow: HD joint 2 counts shoulder + elbow; the elbow is two counts apart."""
+    res = 1e-3
+    E = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0]
+    dev = SimulatedArm(
+        PhantomModel(), ArmDeviceParams(encoder_resolution_rad=res, encoder_matrix=E)
+    )
+    off_own_count = 0
+    for _ in range(60):
+        dev.apply([0.0, 0.0, 0.0])  # falls under gravity
+        q = np.array(dev.sample().q)
+        hd = np.array(E).reshape(3, 3) @ q  # what the encoders read: whole counts
+        np.testing.assert_allclose(hd / res, np.round(hd / res), atol=1e-9)
+        assert np.max(np.abs(hd - np.array(E).reshape(3, 3) @ dev.q)) <= res / 2 + 1e-12
+        # the elbow is a difference of two rounded counts: up to a whole count off its motion
+        assert abs(q[2] - dev.q[2]) <= res + 1e-12
+        off_own_count += abs(q[2] - dev.q[2]) > res / 2 + 1e-12
+    assert off_own_count > 0  # it did lie more than half a count off, as one encoder cannot
+    for bad in ([1.0, 0.0], [1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0], [math.nan] * 9):
+        with pytest.raises(ValueError, match="encoder_matrix"):
+            SimulatedArm(PhantomModel(), ArmDeviceParams(encoder_matrix=bad))
+
+
 def test_effort_limits_from_parameters_and_from_the_urdf() -> None:
     dev = SimulatedArm(PhantomModel(), ArmDeviceParams(joint_effort_limits=[0.5, 0.6, 0.7]))
     assert dev.max_effort == (0.5, 0.6, 0.7)

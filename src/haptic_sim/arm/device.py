@@ -5,13 +5,13 @@ Plant: any ``DeviceModel``, ``D(q) q'' + C(q, q') q' + G(q) + friction(q') = tau
 (``haptic_sim.arm.contact``, at every integration stage; ``contact_force_true`` at the sample).
 ``substeps`` RK4 steps per control period (10 at 1 kHz), the effort held over the period, the
 hand's reference and the external force over each sub-step. Coulomb friction is smoothed to
-``Fc tanh(q' / eps)`` (``arm_dynamics.coulomb_smoothing``; docs/design/friction.md).
-Each joint's effort is saturated at ``joint_effort_limits``, else the model's limits, else the
-effort that gives ``max_force_n`` at the tip at the start pose (``haptic_sim.arm.params``).
-Encoders quantize the joint angles to ``encoder_resolution_rad`` (0 = ideal); velocity is their
-backward difference. Hand (``haptic_sim.hand_space``): a mass ``m_h`` moving with the handle
-(``D + m_h J^T J``) held by a grip spring and damper to its reference (``behaviour: none``: no
-hand). Force sensor: three ``ForceSensor`` axes reading the total external force at the handle.
+``Fc tanh(q' / eps)`` (``arm_dynamics.coulomb_smoothing``; docs/design/friction.md). Each
+joint's effort is saturated at ``joint_effort_limits``, else the model's limits, else the effort
+that gives ``max_force_n`` at the tip at the start pose (``haptic_sim.arm.params``).
+Encoders (``haptic_sim.arm.encoders``): counts of the joints or of ``encoder_matrix``'s rows;
+velocity their backward difference. Hand (``haptic_sim.hand_space``): a mass ``m_h`` moving
+with the handle (``D + m_h J^T J``) held by a grip spring and damper to its reference
+(``behaviour: none``: none). Force sensor: three axes reading the handle's external force.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from haptic_dob.core.validation import positive, unit_vector, vector
 from haptic_msgs_py.stamps import period_ns
 from haptic_sim.arm.contact import contact_of
 from haptic_sim.arm.dynamics import coulomb_smoothing, dynamics_and_tip, mass_and_bias, solve
+from haptic_sim.arm.encoders import Encoders
 from haptic_sim.arm.params import ArmDeviceParams
 from haptic_sim.device.sample import DeviceSample
 from haptic_sim.hand import HandParams, HandReference
@@ -129,6 +130,7 @@ class SimulatedArm:
         self.tip_force_true = np.zeros(3)  # hand + external force + contact on the tip (N)
         self.contact_force_true = np.zeros(3)  # the contact's force at the sample's state (N)
         self._effort_applied = np.zeros(n)
+        self._encode = Encoders(dev.encoder_resolution_rad, dev.encoder_matrix, n).read
         self._q_enc = self._encode(self.q)
         self._q_enc_prev = self._q_enc
         self._sample = self._make_sample()
@@ -263,12 +265,6 @@ class SimulatedArm:
         self.q, self.v, self.accel = q, v, a1
 
     # --- sensing ---------------------------------------------------------------------------
-    def _encode(self, q: Vec) -> Vec:
-        res = self.device.encoder_resolution_rad
-        if res <= 0.0:
-            return q.copy()
-        return np.round(q / res) * res
-
     def _make_sample(self) -> DeviceSample:
         q = self._q_enc
         qd = self.v.copy() if self._exact_velocity else (q - self._q_enc_prev) / self.dt

@@ -46,6 +46,12 @@ class ArmDeviceParams:
             description="joint encoder resolution; 0 = ideal", unit="rad", bounds=(0.0, 0.1)
         ),
     )
+    encoder_matrix: list[float] | tuple[float, ...] = field(
+        default_factory=list,
+        metadata=param(
+            description="encoders' rows over the joints, flattened; [] = one per joint",
+        ),
+    )
     initial_position: list[float] | tuple[float, ...] = field(
         default_factory=list,
         metadata=param(
