@@ -43,13 +43,22 @@ TICK_S = 1.0 / os.sysconf("SC_CLK_TCK")  # the resolution of /proc/PID/stat's CP
 
 #: the raw DDS hops between processes on a real-time loop's path may take at most this share of a
 #: period: the rest is the device's tick (its wake-up, the plant step, its publishing), the nodes'
-#: work and a loaded machine's jitter. Four processes on two cores turn the command around in
-#: 1.1-1.5x the floor of three hops (median latencies) and miss the next tick on about half the
-#: cycles once that median passes 0.75 of a period; one hop's median changes by up to 2x from
-#: one second to the next on a virtual machine, hence the slower of two measurements
-#: (BENCHMARKS.md)
+#: work and a loaded machine's jitter: a floor no loop goes under. A test that asserts most
+#: commands on time takes its path's measured latency instead (``require_path_latency``). One
+#: hop's median changes by up to 2x from one second to the next on a virtual machine, hence the
+#: slower of two measurements (BENCHMARKS.md)
 HOPS_SHARE = 0.5
 HOP_MESSAGES = 2000  # round trips of one hop measurement (about 1 s)
+
+#: a real-time path's median command latency in raw DDS hops, measured on the development
+#: machine (BENCHMARKS.md): four processes, OL, as ``test_graph_realtime`` runs it (3.0 times
+#: its three hops); the bridge composed with the loop against the Force Dimension-, Touch- and
+#: arm-like test drivers (6.7, 9.8 and 8.2 times one hop, 617db16). The ratio holds on a slower
+#: machine (one with a 150 us hop put four processes' median past a period: 42 % on time)
+PATH_HOPS = {"processes": 9.0, "fd": 6.7, "touch": 9.8, "arm": 8.2}
+#: a path's median latency may take this share of a period: past it, about half the commands
+#: miss the next tick
+LATENCY_SHARE = 0.75
 
 #: the command's paths through the loop's nodes (OL and CL: the wall; DOB: the observer too)
 PATHS = {
@@ -347,4 +356,20 @@ def require_hop_floor(hops: int, hop_us_now: float, rate_hz: float = 1000.0) -> 
             f"{hops} raw DDS hops between processes take {floor_us:.0f} us on this machine, "
             f"measured now ({hop_us_now:.0f} us each); a real-time loop at {rate_hz:g} Hz "
             f"across them needs at most {budget_us:.0f} us"
+        )
+
+
+def require_path_latency(path: str, hop_us_now: float, rate_hz: float = 1000.0) -> None:
+    """Skip the calling test unless ``path``'s median latency, ``PATH_HOPS[path]`` raw hops of
+    ``hop_us_now`` (µs, the slower of the measurements around the run), fits in
+    ``LATENCY_SHARE`` of a period at ``rate_hz``: past that, this machine now turns the command
+    around after the next tick about half the time, whatever the path's code does."""
+    hops = PATH_HOPS[path]
+    expected_us = hops * hop_us_now
+    budget_us = LATENCY_SHARE * 1e6 / rate_hz
+    if expected_us > budget_us:
+        pytest.skip(
+            f"the {path} path's median latency, {hops:g} raw DDS hops on the development "
+            f"machine, is {expected_us:.0f} us with this machine's hop now ({hop_us_now:.0f} "
+            f"us); a real-time loop at {rate_hz:g} Hz needs it under {budget_us:.0f} us"
         )

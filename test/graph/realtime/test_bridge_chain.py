@@ -29,7 +29,7 @@ from haptic_dob.bag.cdr import decode_vectors
 from haptic_dob.core.environment import VirtualWall
 from haptic_dob.core.models import UrdfModel
 from haptic_dob.runtime.params import build, load_node_params, node_view
-from support.capacity import hop_floor_us, require_hop_floor, require_realtime
+from support.capacity import hop_floor_us, require_path_latency, require_realtime
 from support.drivers import plants
 from support.drivers.run import (
     CHAIN_ON_TIME,
@@ -54,12 +54,13 @@ TOUCH_HAND = {
 }
 
 
-def premise(rate_hz: float) -> list[float]:
-    """Skip unless the composed loop with its recorder and the bridge's two hops fit real time
-    at ``rate_hz`` (DOB: the observer on the command's path); the hop measured now."""
+def premise(path: str, rate_hz: float) -> list[float]:
+    """Skip unless the composed loop with its recorder fits real time at ``rate_hz`` (DOB: the
+    observer on the command's path) and the bridge's ``path`` (``PATH_HOPS``) fits a period with
+    this machine's raw hop; the hop measured now."""
     require_realtime([SLIDE_LOOP], "DOB", record=True)
     hops = [hop_floor_us()]
-    require_hop_floor(2, hops[0], rate_hz)
+    require_path_latency(path, hops[0], rate_hz)
     return hops
 
 
@@ -158,7 +159,7 @@ def estimate_error(truth: Truth, bag: Path, config: str) -> float:
 def test_forcedimension_chain_through_the_bridge(tmp_path: Path) -> None:
     """Excite, record, identify every axis, then DOB with that model, the hand pushing +x into
     the 800 N/m wall: issue 31's figures against the driver's hidden point mass."""
-    hops = premise(1000.0)
+    hops = premise("fd", 1000.0)
     figures = Figures()
     config = "bridge_forcedimension.yaml"
     excite = ["--params", str(CONFIG / "excite" / "forcedimension.yaml")]
@@ -178,7 +179,7 @@ def test_forcedimension_chain_through_the_bridge(tmp_path: Path) -> None:
     dob += ["--set", f"bridge_node:duration_s={DOB_S}"]
     truth, counts, bag = session(tmp_path, "dob", driver, config, dob)
     hops.append(hop_floor_us())
-    require_hop_floor(2, max(hops))
+    require_path_latency("fd", max(hops))
     figures.premise(kept_real_time(truth, counts, 1000.0))
     error = estimate_error(truth, bag, config)
     figures.check(error <= 0.05, f"estimate {100 * error:.1f} % of the span")
@@ -191,7 +192,7 @@ def test_touch_chain_through_the_bridge(tmp_path: Path) -> None:
     elbow's and shoulder's gravity torque within 5 % of the plant's at the start), the Coulomb
     friction within 20 % and the viscous within 10 %, and issue 31's 5 % not reached
     (docs/devices.md: the encoder's counts at 500 Hz)."""
-    hops = premise(500.0)
+    hops = premise("touch", 500.0)
     figures = Figures()
     config = "bridge_touch.yaml"
     excite = ["--params", str(CONFIG / "excite" / "touch.yaml")]
@@ -220,7 +221,7 @@ def test_touch_chain_through_the_bridge(tmp_path: Path) -> None:
     dob += ["--set", f"bridge_node:duration_s={DOB_S}"]
     truth, counts, bag = session(tmp_path, "dob", {**driver, "hand": TOUCH_HAND}, config, dob)
     hops.append(hop_floor_us())
-    require_hop_floor(2, max(hops), 500.0)
+    require_path_latency("touch", max(hops), 500.0)
     figures.premise(kept_real_time(truth, counts, 500.0))
     error = estimate_error(truth, bag, config)
     figures.check(error <= 0.12, f"estimate {100 * error:.1f} % of the span")

@@ -8,7 +8,7 @@ rate (commands for most states, most of them before the driver's next state, as 
 driver), that nothing is refused, and that the wall (the arm's table) is rendered, from the
 driver's truth. The share of commands on time is a benchmark (``scripts/bench_bridge.py``), not
 asserted here beyond "most". Skips where the suite's capacity measurement says this machine
-cannot carry a composed loop in real time now, or the two raw DDS hops of the bridge's path.
+cannot carry a composed loop in real time now, or the bridge's path with its raw DDS hop.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from haptic_dob.core.models.urdf import UrdfModel
-from support.capacity import hop_floor_us, require_hop_floor, require_realtime
+from support.capacity import hop_floor_us, require_path_latency, require_realtime
 from support.drivers.run import DRIVER_SHARE, ON_TIME, SLIDE_HAND, Truth, bridge_session, start
 from support.paths import ROOT
 from support.rosgraph import Collector, isolated_env, launch
@@ -33,12 +33,13 @@ RUN_S = 4.0
 SLIDE_LOOP = ["device_node", "environment_node", "observer_node", "controller_node"]
 
 
-def premise(rate_hz: float) -> list[float]:
-    """Skip unless the composed loop and the bridge's two hops fit real time at ``rate_hz``;
-    the hop measured now (the test measures it again after its run)."""
+def premise(path: str, rate_hz: float) -> list[float]:
+    """Skip unless the composed loop fits real time at ``rate_hz`` and the bridge's ``path``
+    (``PATH_HOPS``: its two hops and the work between) fits a period with this machine's raw
+    hop; the hop measured now (the test measures it again after its run)."""
     require_realtime([SLIDE_LOOP])
     hops = [hop_floor_us()]
-    require_hop_floor(2, hops[0], rate_hz)
+    require_path_latency(path, hops[0], rate_hz)
     return hops
 
 
@@ -95,11 +96,11 @@ def weight_down(truth: Truth) -> np.ndarray:
 def test_forcedimension_loop_closes_at_1khz_and_renders_the_wall(tmp_path) -> None:
     """forcedimension_ros2-like: joint_states fd_x, fd_y, fd_z, Float64MultiArray commands; the
     hand pushes +x into the 800 N/m wall at x = 0."""
-    hops = premise(1000.0)
+    hops = premise("fd", 1000.0)
     driver = {"kind": "fd", "rate_hz": 1000.0, "hand": SLIDE_HAND, "hand_direction": [1, 0, 0]}
     truth, counts = run_session(tmp_path, driver, "bridge_forcedimension.yaml", [])
     hops.append(hop_floor_us())
-    require_hop_floor(2, max(hops))
+    require_path_latency("fd", max(hops))
     closes(truth, counts, 1000.0)
     ratio = rendered(truth.q[:, 0], truth.hand[:, 0], 800.0)
     assert 0.7 < ratio < 1.3, ratio
@@ -110,12 +111,12 @@ def test_touch_loop_closes_at_500hz_and_renders_the_wall(tmp_path) -> None:
     the driver's pose frame (the URDF's base frame), applied only while the stylus's white
     button is held (the bridge's dead-man too); the hand pushes down into the 400 N/m floor
     5 mm below the stylus's start."""
-    hops = premise(500.0)
+    hops = premise("touch", 500.0)
     hand = {**SLIDE_HAND, "offset_m": 0.012}
     driver = {"kind": "touch", "rate_hz": 500.0, "hand": hand, "hand_direction": [0, 0, -1]}
     truth, counts = run_session(tmp_path, driver, "bridge_touch.yaml", [])
     hops.append(hop_floor_us())
-    require_hop_floor(2, max(hops), 500.0)
+    require_path_latency("touch", max(hops), 500.0)
     closes(truth, counts, 500.0)
     depth = -0.0817 - truth.tip[:, 2]  # bridge_touch.yaml's floor
     # the stylus rests on the floor with the hand's push and its weight (nothing compensates it)
@@ -137,7 +138,7 @@ def test_arm_as_teleoperation_slave_through_the_bridge(tmp_path) -> None:
 
     require_realtime_teleop(composed=True)
     hops = [hop_floor_us()]
-    require_hop_floor(2, hops[0])
+    require_path_latency("arm", hops[0])
     env = isolated_env()
     stats = tmp_path / "bridge.json"
     drv = start({"kind": "arm", "rate_hz": 1000.0, "table_z": 0.39}, env, tmp_path / "driver")
@@ -159,7 +160,7 @@ def test_arm_as_teleoperation_slave_through_the_bridge(tmp_path) -> None:
         col.close()
     truth, counts = Truth.read(tmp_path / "driver"), json.loads(stats.read_text())
     hops.append(hop_floor_us())
-    require_hop_floor(2, max(hops))
+    require_path_latency("arm", max(hops))
     closes(truth, counts, 1000.0)
     est = {
         m.header.stamp.sec * 10**9 + m.header.stamp.nanosec: m.wrench.force.z
