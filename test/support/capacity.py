@@ -349,14 +349,13 @@ def require_hop_floor(hops: int, hop_us_now: float, rate_hz: float = 1000.0) -> 
     the measurements around the run) fit in ``HOPS_SHARE`` of a period at ``rate_hz``: past
     that, no loop across those processes holds the rate on this machine now, whatever its
     nodes do."""
-    floor_us = hops * hop_us_now
-    budget_us = HOPS_SHARE * 1e6 / rate_hz
-    if floor_us > budget_us:
-        pytest.skip(
-            f"{hops} raw DDS hops between processes take {floor_us:.0f} us on this machine, "
-            f"measured now ({hop_us_now:.0f} us each); a real-time loop at {rate_hz:g} Hz "
-            f"across them needs at most {budget_us:.0f} us"
-        )
+    _skip_over(
+        hops * hop_us_now,
+        HOPS_SHARE * 1e6 / rate_hz,
+        f"{hops} raw DDS hops between processes take {{:.0f}} us on this machine, measured now "
+        f"({hop_us_now:.0f} us each); a real-time loop at {rate_hz:g} Hz across them needs at "
+        "most {:.0f} us",
+    )
 
 
 def require_path_latency(path: str, hop_us_now: float, rate_hz: float = 1000.0) -> None:
@@ -365,11 +364,17 @@ def require_path_latency(path: str, hop_us_now: float, rate_hz: float = 1000.0) 
     ``LATENCY_SHARE`` of a period at ``rate_hz``: past that, this machine now turns the command
     around after the next tick about half the time, whatever the path's code does."""
     hops = PATH_HOPS[path]
-    expected_us = hops * hop_us_now
-    budget_us = LATENCY_SHARE * 1e6 / rate_hz
-    if expected_us > budget_us:
-        pytest.skip(
-            f"the {path} path's median latency, {hops:g} raw DDS hops on the development "
-            f"machine, is {expected_us:.0f} us with this machine's hop now ({hop_us_now:.0f} "
-            f"us); a real-time loop at {rate_hz:g} Hz needs it under {budget_us:.0f} us"
-        )
+    _skip_over(
+        hops * hop_us_now,
+        LATENCY_SHARE * 1e6 / rate_hz,
+        f"the {path} path's median latency, {hops:g} raw DDS hops on the development machine, "
+        f"is {{:.0f}} us with this machine's hop now ({hop_us_now:.0f} us); a real-time loop at "
+        f"{rate_hz:g} Hz needs it under {{:.0f}} us",
+    )
+
+
+def _skip_over(us: float, budget_us: float, text: str) -> None:
+    """Skip the calling test, saying ``text`` with both figures, when ``us`` passes
+    ``budget_us``."""
+    if us > budget_us:
+        pytest.skip(text.format(us, budget_us))

@@ -28,7 +28,7 @@ from haptic_msgs_py.stamps import period_ns
 from haptic_sim.arm.contact import contact_of
 from haptic_sim.arm.dynamics import coulomb_smoothing, dynamics_and_tip, mass_and_bias, solve
 from haptic_sim.arm.encoders import Encoders
-from haptic_sim.arm.params import ArmDeviceParams
+from haptic_sim.arm.params import ArmDeviceParams, effort_limits
 from haptic_sim.device.sample import DeviceSample
 from haptic_sim.hand import HandParams, HandReference
 from haptic_sim.hand_space import hand_references
@@ -93,7 +93,7 @@ class SimulatedArm:
             self._tip_motion = cast(Any, model)._tip_motion
         self._viscous = np.asarray(getattr(model, "viscous", np.zeros(self.dof)), dtype=np.float64)
         self._coulomb, self._coulomb_eps = coulomb_smoothing(model, self._dyn, q0, self.dt_physics)
-        self.effort_limits = self._limits(q0)
+        self.effort_limits = effort_limits(dev, model, q0)
         #: actuator saturation per joint (N m or N), the ``SimulatedDevice`` protocol's name
         self.max_effort = tuple(self.effort_limits.tolist())
         self._lim = self.effort_limits
@@ -174,16 +174,6 @@ class SimulatedArm:
         self._sample = self._make_sample()
 
     # --- physics ---------------------------------------------------------------------------
-    def _limits(self, q0: Vec) -> Vec:
-        dev, n = self.device, self.dof
-        if dev.joint_effort_limits:
-            return vector("joint_effort_limits", list(dev.joint_effort_limits), n)
-        own = getattr(self.model, "effort_limits", None)
-        if own is not None and len(own) == n and all(v > 0.0 for v in own):
-            return np.array(own, dtype=np.float64)
-        J = self.model._jacobian(q0)
-        return cast(Vec, dev.max_force_n * np.maximum(np.linalg.norm(J, axis=0), 0.01))
-
     def _accel(self, q: Vec, v: Vec, tau: Vec, f_ext: Vec, ref: tuple[Vec, Vec, Vec] | None) -> Vec:
         """Joint acceleration; with tip forces also records (grip, J, J' q', f_ext) in ``_last``."""
         if self._aba and ref is None:  # b q' + Fc tanh(q' / eps) in one go, then ABA

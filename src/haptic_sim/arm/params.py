@@ -1,5 +1,5 @@
-"""Settings of the simulated arm (``haptic_sim.arm.device``): actuators, encoders, start, hand,
-force.
+"""Settings of the simulated arm (``haptic_sim.arm.device``): actuators (and the effort limits
+they give), encoders, start, hand, force.
 
 Defaults are the PHANToM Premium 1.5's: ``max_force_n`` 8.5 N, the peak ("maximum exertable")
 force SensAble specifies at its nominal position (continuous force is about 1.4 N; the thesis
@@ -10,7 +10,11 @@ nominal tip resolution over the PHANToM 1.5's ~0.2 m links (0 = ideal encoders).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import cast
 
+import numpy as np
+
+from haptic_dob.core.models.base import DeviceModel, Vec
 from haptic_dob.core.validation import nonnegative, positive, unit_vector, vector
 from haptic_dob.runtime.params import param
 
@@ -103,3 +107,16 @@ class ArmDeviceParams:
             raise ValueError(
                 f"velocity must be one of {', '.join(VELOCITY_SOURCES)}, got {self.velocity!r}"
             )
+
+
+def effort_limits(device: ArmDeviceParams, model: DeviceModel, q0: Vec) -> Vec:
+    """Each joint's effort limit (N m or N): ``joint_effort_limits``, else the model's own
+    limits, else the effort that gives ``max_force_n`` at the tip at the start pose ``q0``."""
+    n = model.dof
+    if device.joint_effort_limits:
+        return vector("joint_effort_limits", list(device.joint_effort_limits), n)
+    own = getattr(model, "effort_limits", None)
+    if own is not None and len(own) == n and all(v > 0.0 for v in own):
+        return np.array(own, dtype=np.float64)
+    J = model._jacobian(q0)
+    return cast(Vec, device.max_force_n * np.maximum(np.linalg.norm(J, axis=0), 0.01))
