@@ -4,7 +4,8 @@
 
 What a real-time session through ``bridge_node`` and a test driver does when every command
 arrives before the driver's next tick (or, with ``late``, that share of them after it: this
-process held up, the next state waiting in its queue), sample for sample: the driver ticks its plant
+process held up, the next state waiting in its queue; with ``crossing``, that share sent just
+after the next tick, before its state could be heard), sample for sample: the driver ticks its plant
 (``support.drivers.plants``) with the effort in force (a ros2_control driver writes the newest
 command at its next cycle; a Touch driver applies the newest force on arrival while its white
 button is held, here always), publishes its state (a Force Dimension's position, velocity and
@@ -74,11 +75,18 @@ def run_bridge(
     seconds: float,
     late: float = 0.0,
     seed: int = 0,
+    state_delay_s: float = 0.0,
+    crossing: float = 0.0,
 ) -> BridgeRecord:
     """The session ``nodes`` (a bridge config's node sections) against ``plant`` for
-    ``seconds`` of driver time; each command late with probability ``late`` (``seed``): sent
-    1.3 periods after its state's instant, after the next state's instant, and that state heard
-    only after it (it waited in the queue); the driver takes it at the tick after."""
+    ``seconds`` of driver time, each state heard ``state_delay_s`` after its instant at the
+    least (one machine's clock: the bridge is told the system time too), a command taken by the
+    driver at the first tick after it was sent. Each command late with probability ``late``
+    (``seed``): sent 1.3 periods after its state's instant, after the next state's instant, and
+    that state heard only after it (it waited in the queue); or, with probability ``crossing``,
+    sent half the state's delay after the next state's instant, before that state could be
+    heard. Either way the driver takes it at the tick after. The rest are sent a tenth of a
+    period after their state is heard."""
     v = node_view(nodes, "bridge_node")
     driver = DriverSettings.of(v)
     model = build_model(v)
@@ -129,8 +137,9 @@ def run_bridge(
         else:
             state = reader.joints(s.stamp_ns, names, s.q, s.qd, s.effort)
         t = k * period  # the state's instant
-        at, heard = max(t, heard), t + period  # heard at its instant, or after a late command
-        sample, zero = bridge.on_state(state, at)
+        at = max(t + state_delay_s, heard)  # its delay after its instant, or after a late command
+        heard = t + period + state_delay_s
+        sample, zero = bridge.on_state(state, at, s.stamp_ns + round((at - t) * 1e9))
         held = _sent(zero, held)
         if sample is None:
             continue
@@ -144,10 +153,12 @@ def run_bridge(
             (0.0, 0.0, 0.0),
         )
         command = EffortCommand(sample.stamp_ns, tuple(tau))
-        if rng.random() < late:  # after the next state's instant, which then waits for it
-            send = bridge.on_command(command, t + 1.3 * period)
+        draw = rng.random()
+        if draw < late + crossing:  # it reaches the driver after the next state's instant
+            sent = t + 1.3 * period if draw < late else t + period + 0.5 * state_delay_s
+            send = bridge.on_command(command, sent)
             pending = None if send is None else np.array(send.values, dtype=np.float64)
-            heard = t + 1.35 * period
+            heard = max(heard, sent + 0.05 * period)  # the next state waited for it
         else:
             held = _sent(bridge.on_command(command, at + 0.1 * period), held)
         truth = (applied, f_est, s.hand_force, s.ee_position)

@@ -95,7 +95,7 @@ class BridgeLoop:
         self.watchdog = CommandWatchdog(period_ns(rate_hz), self._tripped, self._resumed)
         self._say = say
         self._zero_model = (0.0,) * model.dof
-        self.clock = DriverClock()
+        self.clock = DriverClock(self.period_s)
         self._sent = SentLog((0.0,) * n)  # the driver's elements sent, by send time
         #: the previous state's q and tip Jacobian (None: not known)
         self._prev: tuple[tuple[float, ...], NDArray[np.float64] | None] = (self._zero_model, None)
@@ -119,9 +119,12 @@ class BridgeLoop:
         self.state_trips = self.deadman_releases = self.repeated = 0
 
     # --- the driver's state --------------------------------------------------------------
-    def on_state(self, s: DriverState, now: float) -> tuple[LoopSample | None, Send | None]:
-        """Driver state ``s`` arrived at monotonic ``now`` (s): the loop's sample (None while
-        not handing on) and a zero to send first (None when none is due)."""
+    def on_state(
+        self, s: DriverState, now: float, now_ns: int | None = None
+    ) -> tuple[LoopSample | None, Send | None]:
+        """Driver state ``s`` arrived at monotonic ``now`` (s), on the system clock at
+        ``now_ns`` (None: not known): the loop's sample (None while not handing on) and a zero
+        to send first (None when none is due)."""
         if self.stopping:
             return None, None
         if s.stamp_ns <= self.newest_ns:  # a stamp that did not advance: not a new state
@@ -138,7 +141,7 @@ class BridgeLoop:
         if self.state_stale:
             self.state_stale = False
             self._say("driver state again: the loop resumes")
-        instant = self.clock.heard(s.stamp_ns, now)
+        instant = self.clock.heard(s.stamp_ns, now, now_ns)
         self._instants.append(instant)
         if not self.started:
             return None, self._zero(s.stamp_ns, "the loop is not up yet", now)
@@ -288,4 +291,5 @@ class BridgeLoop:
             "state_trips": self.state_trips,
             "deadman_releases": self.deadman_releases,
             "states_not_advancing": self.repeated,
+            "state_age_ms": self.clock.age_s * 1e3,
         }

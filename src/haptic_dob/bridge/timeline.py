@@ -1,8 +1,8 @@
 """Which command a driver had in force, by the driver's clock, for the bridge (``loop``).
 
-``DriverClock`` puts each driver state's stamp on this process's monotonic clock; ``SentLog``
-keeps the commands sent with their send times, so the bridge can ask which was the newest sent
-before a driver cycle's instant.
+``DriverClock`` puts each driver state's stamp on this process's monotonic clock (exactly, where
+this machine's clock is the driver's); ``SentLog`` keeps the commands sent with their send
+times, so the bridge can ask which was the newest sent before a driver cycle's instant.
 """
 
 from __future__ import annotations
@@ -11,11 +11,36 @@ import math
 from collections import deque
 
 
+class RecentLeast:
+    """The least of the values added over the last one or two blocks of ``block``."""
+
+    def __init__(self, block: int) -> None:
+        self._block = block
+        self._older = self._newer = math.inf
+        self._count = 0
+
+    def add(self, value: float) -> float:
+        """Add ``value``; the least now."""
+        self._newer = min(self._newer, value)
+        self._count += 1
+        if self._count == self._block:
+            self._older, self._newer, self._count = self._newer, math.inf, 0
+        return self.value
+
+    @property
+    def value(self) -> float:
+        return min(self._older, self._newer)
+
+
 class DriverClock:
-    """Where the driver's stamps fall on this process's monotonic clock: a state's instant is
-    its stamp plus the least delay after its stamp at which any state of the last ``2 BLOCK``
-    was heard (a one-way hop when the driver's and this machine's clocks agree; it takes up an
-    offset when they do not, and receipt stamps).
+    """Where the driver's stamps fall on this process's monotonic clock.
+
+    The least delay after its stamp at which any state of the last ``2 BLOCK`` was heard is the
+    state's least age here plus the clocks' offset. Given each state's receipt on the system
+    clock (``now_ns``), the least delay there is that age itself when the driver stamps on this
+    clock (one machine): ``age_s``, and a state's instant is its stamp. Where it is negative or
+    a period or more, the clocks are not one: the age is taken as 0, the instant as the earliest
+    the state could be heard.
 
     A command counts from the driver's cycle whose instant it was sent before, not from the
     first state this process handled after it: a state can wait in the queue while this
@@ -23,21 +48,28 @@ class DriverClock:
 
     BLOCK = 500  # states
 
-    def __init__(self) -> None:
+    def __init__(self, period_s: float) -> None:
+        self._period_s = period_s
         self._origin_ns: int | None = None
-        self._older = self._newer = math.inf  # the least delay (s) in the last two blocks
-        self._count = 0
+        self._delay = RecentLeast(self.BLOCK)  # s, on the monotonic clock (takes up an offset)
+        self._system = RecentLeast(self.BLOCK)  # s, on the system clock: the age if one clock
 
-    def heard(self, stamp_ns: int, now: float) -> float:
-        """State ``stamp_ns`` heard at monotonic ``now`` (s): its instant (monotonic s)."""
+    def heard(self, stamp_ns: int, now: float, now_ns: int | None = None) -> float:
+        """State ``stamp_ns`` heard at monotonic ``now`` (s), system ``now_ns``: its instant
+        (monotonic s)."""
         if self._origin_ns is None:
             self._origin_ns = stamp_ns
         t = (stamp_ns - self._origin_ns) * 1e-9
-        self._newer = min(self._newer, now - t)
-        self._count += 1
-        if self._count == self.BLOCK:
-            self._older, self._newer, self._count = self._newer, math.inf, 0
-        return t + min(self._older, self._newer)
+        least = self._delay.add(now - t)
+        if now_ns is not None:
+            self._system.add((now_ns - stamp_ns) * 1e-9)
+        return t + least - self.age_s
+
+    @property
+    def age_s(self) -> float:
+        """The least age (s) at which a state is heard here, 0 where the clocks are not one."""
+        age = self._system.value
+        return age if 0.0 <= age < self._period_s else 0.0
 
 
 class SentLog:

@@ -139,15 +139,15 @@ class BridgeNode(LoopNode):
 
     # --- the cycle: driver state -> loop -> driver command ------------------------------------
     def _on_state(self, data: bytes) -> None:
-        now = time.monotonic()
+        now, now_ns = time.monotonic(), time.time_ns()
         try:
             m = self._decode(data)
-            stamp = time.time_ns() if self._on_receipt else m.stamp_ns
+            stamp = now_ns if self._on_receipt else m.stamp_ns
             if self.reader.pose:
                 state = self.reader.position(stamp, m.vector)
             else:
                 state = self.reader.joints(stamp, m.name, m.position, m.velocity, m.effort)
-            sample, zero = self.loop.on_state(state, now)
+            sample, zero = self.loop.on_state(state, now, now_ns)
         except ValueError as exc:
             if str(exc) != self._bad_state:  # once per distinct problem, not at 1 kHz
                 self.log.error(f"ignoring the driver's state: {exc}")

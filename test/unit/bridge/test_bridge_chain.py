@@ -110,19 +110,24 @@ def test_forcedimension_dob_estimates_the_hand_within_5_percent(fd) -> None:
 
 
 def test_late_commands_are_reported_where_they_act_and_the_fit_holds(tmp_path: Path) -> None:
-    """Half the commands late (sent after the driver's next instant, the next state waiting in
-    this process's queue): the effort the bridge reports is, sample for sample, the one the
-    plant had; the bridge counts them late; the fit is the one of every command on time. (When
-    the bridge went by the order it heard states in, it reported 10230 of 21001 samples wrong,
-    counted every command on time, and the viscous friction came out 6-10 % low.)"""
+    """A quarter of the commands late (sent after the driver's next instant, the next state
+    waiting in this process's queue) and a quarter sent after that instant but before its
+    state could be heard (states heard 150 us after their stamps): the effort the bridge
+    reports is, sample for sample, the one the plant had; the bridge counts them late; the fit
+    is the one of every command on time. (When the bridge went by the order it heard states in,
+    it reported 10230 of 21001 samples wrong with half the commands late, counted every command
+    on time, and the viscous friction came out 6-10 % low. When it took a state's instant as
+    the earliest the state could be heard, it reported the second quarter a cycle early: 15548
+    of the 63003 values.)"""
     config = CONFIG / "bridge_forcedimension.yaml"
     excite = session(config, CONFIG / "excite" / "forcedimension.yaml")
     fits = []
-    for late in (0.0, 0.5):
+    for late in (0.0, 0.25):
         plant = plants.point_mass(1000.0, 0, {"behaviour": "none"}, (0.0, 0.0, -1.0))
-        record = run_bridge(excite, plant, EXCITE_S, late=late)
+        record = run_bridge(excite, plant, EXCITE_S, late=late, state_delay_s=150e-6, crossing=late)
         np.testing.assert_array_equal(record.effort, record.applied)
-        assert record.counts["on_time_pct"] == pytest.approx(100.0 * (1.0 - late), abs=2.0)
+        assert record.counts["on_time_pct"] == pytest.approx(100.0 * (1.0 - 2 * late), abs=2.0)
+        assert record.counts["state_age_ms"] == pytest.approx(0.15)
         model = identified(record, tmp_path / f"late{late}", ["--axes", "fd_x,fd_y,fd_z"])
         fits.append(load_node_params(model)["observer_node"])
     for key in ("point_mass.mass_kg", "point_mass.viscous_n_s_per_m"):
@@ -130,12 +135,13 @@ def test_late_commands_are_reported_where_they_act_and_the_fit_holds(tmp_path: P
 
 
 def test_a_touchs_late_forces_are_reported_at_the_posture_they_act_in() -> None:
-    """A Cartesian-force driver, half its forces late: the joint effort the bridge reports for
-    [k-1, k) is, sample for sample, J(q_k-1)^T F of the force the driver held there (a late
-    force acts a sample later, at a posture later than the state it answered)."""
+    """A Cartesian-force driver, a quarter of its forces late and a quarter sent after the next
+    state's instant but before it could be heard (300 us after): the joint effort the bridge
+    reports for [k-1, k) is, sample for sample, J(q_k-1)^T F of the force the driver held
+    there (a late force acts a sample later, at a posture later than the state it answered)."""
     excite = session(CONFIG / "bridge_touch.yaml", CONFIG / "excite" / "touch.yaml")
     plant = plants.touch(500.0, 0, {"behaviour": "none"}, (0.0, 0.0, -1.0))
-    record = run_bridge(excite, plant, 5.0, late=0.5)
+    record = run_bridge(excite, plant, 5.0, late=0.25, state_delay_s=300e-6, crossing=0.25)
     assert np.abs(record.applied).max() > 0.01  # it was pushing (N m)
     np.testing.assert_allclose(record.effort, record.applied, rtol=0.0, atol=1e-12)
 

@@ -166,14 +166,43 @@ def test_a_command_sent_after_the_drivers_next_instant_is_late_and_not_in_force_
         assert [efforts[k] for k in range(5, 9)] == [1.5, 2.0, 2.0, 3.0]
 
 
-def test_the_drivers_clock_may_be_another_one() -> None:
-    """Stamps on a clock 1000 s off this one, the least delay 40 us: instants on this clock."""
-    clock = DriverClock()
+@pytest.mark.parametrize("system", [False, True])
+def test_the_drivers_clock_may_be_another_one(system: bool) -> None:
+    """Stamps on a clock 1000 s off this one, the least delay 40 us: instants on this clock,
+    the earliest the states could be heard (told the system clock or not)."""
+    clock = DriverClock(1e-3)
     off = 1000 * 1_000_000_000
     for k, extra in enumerate([0.3e-3, 40e-6, 0.1e-3, 5e-3]):
-        at = clock.heard(off + k * T, 2.0 + k * 1e-3 + extra)
-    assert at == pytest.approx(2.0 + 3e-3 + 40e-6)
-    assert clock.heard(off + 10 * T, 2.02) == pytest.approx(2.0 + 10e-3 + 40e-6)
+        now = 2.0 + k * 1e-3 + extra
+        at = clock.heard(off + k * T, now, round(now * 1e9) if system else None)
+    assert at == pytest.approx(2.0 + 3e-3 + 40e-6) and clock.age_s == 0.0
+    later = clock.heard(off + 10 * T, 2.02, 2_020_000_000 if system else None)
+    assert later == pytest.approx(2.0 + 10e-3 + 40e-6)
+
+
+def test_on_one_clock_a_states_instant_is_its_stamp() -> None:
+    """The driver stamps on this machine's clock (system = monotonic + 5 s), states heard 200 us
+    after their stamps at the least: a state's instant is its stamp. A command sent 100 us after
+    the next instant, before that state could be heard, is late and in force a cycle later
+    (delay 0); one sent 50 us before it is on time."""
+    b = bridge(0)
+    b.start()
+    system_ns = 5_000_000_000
+
+    def heard(k: int, now: float) -> float:
+        sample = b.on_state(state(k), now, round(now * 1e9) + system_ns)[0]
+        assert sample is not None
+        return sample.effort[0]
+
+    for k in range(1, 4):  # stamps k ms - 5 s on this monotonic clock
+        heard(k, k * 1e-3 - 5.0 + 200e-6 + (k == 2) * 300e-6)
+    assert b.clock.age_s == pytest.approx(200e-6)
+    t3 = 3e-3 - 5.0  # state 3's instant
+    b.on_command(cmd(3, 1.0, 0.0, 0.0), t3 + 1e-3 + 100e-6)  # after state 4's instant
+    assert heard(4, t3 + 1e-3 + 200e-6) == 0.0  # not in force over [3, 4)
+    b.on_command(cmd(4, 2.0, 0.0, 0.0), t3 + 2e-3 - 50e-6)  # before state 5's
+    assert heard(5, t3 + 2e-3 + 200e-6) == 2.0
+    assert (b.on_time, b.late) == (1, 1) and b.counts()["state_age_ms"] == pytest.approx(0.2)
 
 
 def test_late_commands_are_counted_per_state() -> None:
