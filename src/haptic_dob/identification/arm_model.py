@@ -2,8 +2,8 @@
 
 ROS-free. The URDF gives the kinematics and CAD values, the record joint positions and applied
 efforts (positions differentiated through ``filters``). Effort = ``W theta`` (``arm_parameters``):
-1. the regressor on the first ``1 - holdout`` of the record (filters' ends out, decimated), on
-   the light motion and filtered like the effort (``filters``: nonlinear in the motion);
+1. the regressor on the first ``1 - holdout`` of the record (filters' ends, lost states and
+   still stretches out; decimated), on the light motion, filtered like the effort;
 2. each base parameter's visibility: one below ``min_visibility`` is refused, named;
 3. least squares (Coulomb a filtered sign), each joint's ``v_c`` (``arm_friction.turn_speed``),
    least squares again on each joint's rows clear of its turns (``clear_rows``), then
@@ -37,6 +37,7 @@ from haptic_dob.identification.arm_model_report import ArmModelFit, JointFit, Li
 from haptic_dob.identification.arm_normal import Normal, condition_number, solve, square_root
 from haptic_dob.identification.arm_urdf import LinkInertial, link_inertials
 from haptic_dob.identification.filters import (
+    HELD_S,
     MIN_SPEED,
     IdentificationError,
     MotionFilters,
@@ -92,10 +93,17 @@ def identify_arm_model(
     tau = f.effort(record.effort)
     v_light = f.light_velocity(position)
     split = int((1.0 - holdout) * n)
+    live = f.contiguous(record.stamps_ns) & ~f.held(np.abs(v_light).max(axis=1), MIN_SPEED, HELD_S)
     idx = np.arange(2 * f.window, split, f.step)
     held = np.arange(split, n - 2 * f.window, f.step)
     if len(held) < 10 or len(idx) * dof < 3 * lay.size:
         raise IdentificationError(f"too short: {len(idx)} samples to fit, {len(held)} held out")
+    idx, held = idx[live[idx]], held[live[held]]
+    if len(held) < 10 or len(idx) * dof < 3 * lay.size:
+        raise IdentificationError(
+            f"too little motion: {len(idx)} samples to fit, {len(held)} held out clear of "
+            f"stretches of {HELD_S:g} s at rest and of states lost on the way"
+        )
     sign = f.coulomb_term(v_light)
     light = light_regressor(cad, f, position)
     W_all = f.smooth(light).reshape(n, dof, -1)

@@ -7,8 +7,9 @@ derivatives and filtered the same way; the Coulomb term is the filtered sign of 
 smoothed velocity. The same linear filters on every term make their lag and gain cancel; a term
 nonlinear in the motion (an arm's rigid body) is computed on a lightly smoothed motion
 (``light_motion``) and filtered after, like the effort (docs/design/identification.md, "The
-filters"). Samples at rest are left out (stiction is in no model), as are the filters' transients
-at both ends and around a gap in the stamps (``contiguous``: states lost), and the rest is
+filters"). Samples at rest are left out (stiction is in no model; an arm's whole fit leaves out
+the stretches it is held still, ``held``), as are the filters' transients at both ends and
+around a gap in the stamps (``contiguous``: states lost), and the rest is
 decimated to about independent residuals so that standard errors mean something. Arrays are
 along axis 0 (one column per joint for an arm).
 """
@@ -34,6 +35,8 @@ FLAT_TURNS = 5.0
 MIN_CLEAR = 40
 #: rad/s (or m/s): slower is at rest for the friction fits (stiction is in no model)
 MIN_SPEED = 0.02
+#: s at rest, at least, for a stretch to be the device held (not a turn or a start from rest)
+HELD_S = 0.5
 
 #: the window (samples) of ``MotionFilters.light_motion``: as short as a quadratic fit's that
 #: smooths the acceleration at all, so that the motion a nonlinear term sees is the true one
@@ -117,6 +120,19 @@ class MotionFilters:
         flat (``usable``); all of them where fewer than ``MIN_CLEAR`` do."""
         clear = self.usable(light_velocity, max(min_speed, FLAT_TURNS * speed))[rows]
         return clear if int(clear.sum()) >= MIN_CLEAR else np.ones(len(rows), dtype=bool)
+
+    def held(self, speed: Arr, min_speed: float, min_s: float) -> NDArray[np.bool_]:
+        """Samples whose filters reach a stretch of at least ``min_s`` where ``speed`` stays
+        under ``min_speed``: the device parked or held (an inkwell, a hand, a stop) by forces in
+        no model, which a fit leaves out."""
+        slow = np.concatenate([[0], (speed < min_speed).astype(np.int8), [0]])
+        starts, ends = np.flatnonzero(np.diff(slow) == 1), np.flatnonzero(np.diff(slow) == -1)
+        out = np.zeros(len(speed), dtype=bool)
+        reach = 2 * self.window
+        for a, b in zip(starts, ends, strict=True):
+            if (b - a) * self.dt >= min_s:
+                out[max(0, a - reach) : b + reach] = True
+        return out
 
     def contiguous(self, stamps_ns: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Samples whose filters' support holds no gap in the stamps (a step of more than 1.5

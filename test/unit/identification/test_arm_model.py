@@ -124,7 +124,7 @@ def test_too_little_excitation_is_refused_naming_what_it_does_not_see(config) ->
     [
         ("no effort", "carries no effort for joint 'joint1'"),
         ("other joints", "has no joint 'joint1'"),
-        ("still", "too little excitation: the record does not see link1.Izz"),
+        ("still", "too little motion: 0 samples to fit, 0 held out clear of stretches"),
     ],
 )
 def test_a_bag_it_cannot_use_gets_one_line_and_exit_2(tmp_path, config, kind, message) -> None:
@@ -178,3 +178,25 @@ def test_option_mistakes_are_named(tmp_path, args, message) -> None:
         timeout=120,
     )
     assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr
+
+
+def test_a_held_start_and_lost_states_are_left_out(config, record) -> None:
+    """The record as a lab's bag has it: 2 s at the start with the arm held still by something
+    the model lacks (an inkwell, a hand; zero effort) and 20 runs of 2-8 states lost on the
+    way. The fit leaves out the samples whose filters reach the held stretch or a gap: each
+    joint's friction within 5 % of the truth's, as on the whole record."""
+    period = int(np.median(np.diff(record.stamps_ns)))
+    n0 = round(2.0e9 / period)
+    stamps = np.concatenate([record.stamps_ns[0] - period * np.arange(n0, 0, -1), record.stamps_ns])
+    position = np.vstack([np.repeat(record.position[:1], n0, axis=0), record.position])
+    effort = np.vstack([np.zeros((n0, record.effort.shape[1])), record.effort])
+    rng = np.random.default_rng(0)
+    lost = np.zeros(len(stamps), dtype=bool)
+    for start in rng.choice(np.arange(n0, len(stamps) - 10), 20, replace=False):
+        lost[start : start + rng.integers(2, 9)] = True
+    held = Record(stamps[~lost], position[~lost], effort[~lost], record.names)
+    fit = identify_slave(config, held)
+    truth = slave_bench(config).truth
+    for j, b, fc in zip(fit.joints, truth.viscous, truth.coulomb, strict=True):
+        assert j.viscous == pytest.approx(b, rel=0.05), j
+        assert j.coulomb == pytest.approx(fc, rel=0.05), j
