@@ -34,6 +34,7 @@ from support.drivers import plants
 from support.drivers.run import (
     CHAIN_ON_TIME,
     DRIVER_SHARE,
+    ON_TIME,
     SLIDE_HAND,
     Truth,
     bridge_session,
@@ -47,6 +48,12 @@ SLIDE_LOOP = ["device_node", "environment_node", "observer_node", "controller_no
 DOB_S = 8.0  # the hand's 1 s ramp, 2 s settling, 5 s in contact
 SETTLE_S = 2.0
 WRENCH = "geometry_msgs/msg/WrenchStamped"
+#: the Touch chain's premise: its viscous friction, 1-2 mN m s/rad, is the figure the loop's
+#: timing moves most. On a machine 2-3 times slower than usual (2026-11-28: stalls to 20 ms,
+#: up to 3 % of the best-effort states lost) the shoulder's, fitted on the driver's own
+#: efforts at every tick, came out -1, -6, -22 and -12 % in runs with 50-60 % of the commands
+#: on time and +10 % at 88 %; the chain passed on usual days, 96-99.6 % on time (BENCHMARKS.md)
+TOUCH_ON_TIME = ON_TIME
 TOUCH_HAND = {
     k.removeprefix("hand."): v
     for k, v in load_node_params(plants.TOUCH_SIM)["device_node"].items()
@@ -77,11 +84,13 @@ def session(
     return truth, counts, bag
 
 
-def kept_real_time(truth: Truth, counts: dict[str, Any], rate_hz: float) -> str:
+def kept_real_time(
+    truth: Truth, counts: dict[str, Any], rate_hz: float, presumed: float = CHAIN_ON_TIME
+) -> str:
     """Skip when the test driver did not hold its rate (its own premise: a real driver does);
-    else '' when ``CHAIN_ON_TIME`` of the commands reached it before its next state, or why not
-    (the figures were measured up to that share late: the test measures on and skips at the end
-    with its figures). No command refused."""
+    else '' when ``presumed`` of the commands reached it before its next state, or why not (the
+    figures were measured down to that share: the test measures on and skips at the end with
+    its figures). No command refused."""
     share = truth.ticked_share()
     if share < DRIVER_SHARE:
         pytest.skip(
@@ -91,11 +100,11 @@ def kept_real_time(truth: Truth, counts: dict[str, Any], rate_hz: float) -> str:
     assert counts["refused_commands"] == 0, counts
     c = truth.counts
     on_time = c["commands_on_time"] / max(1, c["commands_on_time"] + c["commands_late"])
-    if on_time >= CHAIN_ON_TIME:
+    if on_time >= presumed:
         return ""
     return (
         f"{100 * on_time:.1f} % of the commands reached the test driver before its next state "
-        f"at {rate_hz:g} Hz on this machine now (the chain presumes {100 * CHAIN_ON_TIME:g} %)"
+        f"at {rate_hz:g} Hz on this machine now (the chain presumes {100 * presumed:g} %)"
     )
 
 
@@ -198,7 +207,7 @@ def test_touch_chain_through_the_bridge(tmp_path: Path) -> None:
     excite = ["--params", str(CONFIG / "excite" / "touch.yaml")]
     driver: dict[str, Any] = {"kind": "touch", "rate_hz": 500.0, "hand_direction": [0, 0, -1]}
     truth, counts, bag = session(tmp_path, "excite", {**driver, "inkwell": True}, config, excite)
-    figures.premise(kept_real_time(truth, counts, 500.0))
+    figures.premise(kept_real_time(truth, counts, 500.0, TOUCH_ON_TIME))
     urdf = tmp_path / "touch.urdf"
     argv = [tool("haptic-identify"), str(bag), "--urdf", "urdf/phantom_omni.urdf"]
     argv += ["--tip-frame", "tip", "--inertial", "--write-urdf", str(urdf)]
@@ -222,7 +231,7 @@ def test_touch_chain_through_the_bridge(tmp_path: Path) -> None:
     truth, counts, bag = session(tmp_path, "dob", {**driver, "hand": TOUCH_HAND}, config, dob)
     hops.append(hop_floor_us())
     require_path_latency("touch", max(hops), 500.0)
-    figures.premise(kept_real_time(truth, counts, 500.0))
+    figures.premise(kept_real_time(truth, counts, 500.0, TOUCH_ON_TIME))
     error = estimate_error(truth, bag, config)
     figures.check(error <= 0.12, f"estimate {100 * error:.1f} % of the span")
     figures.end()

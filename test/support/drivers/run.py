@@ -202,6 +202,12 @@ class Truth:
         return self.ticks[:, 1]
 
     @property
+    def instants(self) -> np.ndarray:
+        """Monotonic s of each tick's instant: it takes the commands DDS received before it,
+        however late the tick itself is processed (``times``)."""
+        return self.ticks[:, 1] - self.late
+
+    @property
     def published(self) -> np.ndarray:
         return self.ticks[:, 2] > 0.5
 
