@@ -50,6 +50,7 @@ def test_loop_command_stops_zero_within_the_timeout_in_driver_states(tmp_path) -
     cmd = truth.commands
     values, answered = cmd[:, 2:], truth.answered
     pushes = np.flatnonzero(nonzero(values))
+    assert len(pushes), "no push reached the driver"
     if len(pushes) < quiet_after // 2:  # the premise: the loop pushed before it went quiet
         pytest.skip(
             f"{len(pushes)} of the stand-in's {quiet_after} pushes reached the driver on this "

@@ -35,12 +35,12 @@ class RecentLeast:
 class DriverClock:
     """Where the driver's stamps fall on this process's monotonic clock.
 
-    The least delay after its stamp at which any state of the last ``2 BLOCK`` was heard is the
-    state's least age here plus the clocks' offset. Given each state's receipt on the system
-    clock (``now_ns``), the least delay there is that age itself when the driver stamps on this
-    clock (one machine): ``age_s``, and a state's instant is its stamp. Where it is negative or
-    a period or more, the clocks are not one: the age is taken as 0, the instant as the earliest
-    the state could be heard.
+    Given each state's receipt on the system clock (``now_ns``), a least age (receipt less
+    stamp, over the last ``2 BLOCK`` states) from 0 to a period says the driver stamps on this
+    machine's clock: from then on a state's instant is its stamp, put on the monotonic clock
+    (``age_s``: that least age). Otherwise, or until then, it is the earliest the state could be
+    heard: its stamp plus the least delay after it at which any recent state was (which takes
+    up the clocks' offset; ``age_s`` NaN).
 
     A command counts from the driver's cycle whose instant it was sent before, not from the
     first state this process handled after it: a state can wait in the queue while this
@@ -52,7 +52,8 @@ class DriverClock:
         self._period_s = period_s
         self._origin_ns: int | None = None
         self._delay = RecentLeast(self.BLOCK)  # s, on the monotonic clock (takes up an offset)
-        self._system = RecentLeast(self.BLOCK)  # s, on the system clock: the age if one clock
+        self._age = RecentLeast(self.BLOCK)  # s, receipt less stamp on the system clock
+        self.one_clock = False  # the driver stamps on this machine's clock
 
     def heard(self, stamp_ns: int, now: float, now_ns: int | None = None) -> float:
         """State ``stamp_ns`` heard at monotonic ``now`` (s), system ``now_ns``: its instant
@@ -61,15 +62,18 @@ class DriverClock:
             self._origin_ns = stamp_ns
         t = (stamp_ns - self._origin_ns) * 1e-9
         least = self._delay.add(now - t)
-        if now_ns is not None:
-            self._system.add((now_ns - stamp_ns) * 1e-9)
-        return t + least - self.age_s
+        if now_ns is None:
+            return t + least
+        age = self._age.add((now_ns - stamp_ns) * 1e-9)
+        self.one_clock = self.one_clock or 0.0 <= age < self._period_s
+        if not self.one_clock:
+            return t + least
+        return now - (now_ns - stamp_ns) * 1e-9  # the stamp on the monotonic clock
 
     @property
     def age_s(self) -> float:
-        """The least age (s) at which a state is heard here, 0 where the clocks are not one."""
-        age = self._system.value
-        return age if 0.0 <= age < self._period_s else 0.0
+        """The least age (s) of a state on arrival; NaN unless the clocks are one."""
+        return self._age.value if self.one_clock else math.nan
 
 
 class SentLog:

@@ -108,7 +108,8 @@ def identify_arm_friction(
     r, v = _unexplained(rigid, f, position, effort)
     r_w, v_w = (r, v) if wide is f else _unexplained(rigid, wide, position, effort)
     split = int((1.0 - holdout) * n)
-    whole, whole_w = f.contiguous(stamps_ns), wide.contiguous(stamps_ns)  # no gap in reach
+    speed = np.abs(v_light).max(axis=1)  # no gap nor a stretch held still in reach
+    whole, whole_w = f.fit_rows(stamps_ns, speed), wide.fit_rows(stamps_ns, speed)
     every = np.arange(2 * f.window, split, f.step)  # slow samples too: the turn shows there
     every = every[whole[every]]
     every_w = np.arange(2 * wide.window, split, wide.step)

@@ -93,16 +93,19 @@ def identify_arm_model(
     tau = f.effort(record.effort)
     v_light = f.light_velocity(position)
     split = int((1.0 - holdout) * n)
-    live = f.contiguous(record.stamps_ns) & ~f.held(np.abs(v_light).max(axis=1), MIN_SPEED, HELD_S)
     idx = np.arange(2 * f.window, split, f.step)
-    held = np.arange(split, n - 2 * f.window, f.step)
-    if len(held) < 10 or len(idx) * dof < 3 * lay.size:
-        raise IdentificationError(f"too short: {len(idx)} samples to fit, {len(held)} held out")
-    idx, held = idx[live[idx]], held[live[held]]
-    if len(held) < 10 or len(idx) * dof < 3 * lay.size:
+    test_idx = np.arange(split, n - 2 * f.window, f.step)
+    if len(test_idx) < 10 or len(idx) * dof < 3 * lay.size:
+        raise IdentificationError(f"too short: {len(idx)} samples to fit, {len(test_idx)} held out")
+    speed = np.abs(v_light).max(axis=1)
+    live = f.fit_rows(record.stamps_ns, speed)
+    idx, test_idx = idx[live[idx]], test_idx[live[test_idx]]
+    if len(test_idx) < 10 or len(idx) * dof < 3 * lay.size:
+        lost, still = ~f.contiguous(record.stamps_ns), f.held(speed, MIN_SPEED, HELD_S)
         raise IdentificationError(
-            f"too little motion: {len(idx)} samples to fit, {len(held)} held out clear of "
-            f"stretches of {HELD_S:g} s at rest and of states lost on the way"
+            f"too little motion: {len(idx)} samples to fit, {len(test_idx)} held out, once the "
+            f"filters' reach of lost states ({int(lost.sum())} samples) and of stretches still "
+            f"for {HELD_S:g} s ({int(still.sum())} samples) is left out"
         )
     sign = f.coulomb_term(v_light)
     light = light_regressor(cad, f, position)
@@ -126,7 +129,12 @@ def identify_arm_model(
         )
     beta, _, _ = solve(G, b, yy, len(y), bs.base, "the arm")
     speeds = _turn_speeds(
-        (f, wide), (position, record.effort, v_light, light), (W, y, idx, split), bs, beta, lay
+        (f, wide),
+        (position, record.effort, v_light, light),
+        (W, y, idx, split, wide.fit_rows(record.stamps_ns, speed)),
+        bs,
+        beta,
+        lay,
     )
     coulomb = np.column_stack([coulomb_term(f, v_light[:, j], c) for j, c in enumerate(speeds)])
     W = ap.with_coulomb(W, coulomb[idx])
@@ -145,11 +153,11 @@ def identify_arm_model(
     R, z = square_root(Gw, bw)
     found = fit_consistent(R, z, sigma, links, (cad_joint, scale, start))
     _check(lay.links, links, found)
-    W_held = ap.with_coulomb(W_all[held].reshape(len(held) * dof, -1), coulomb[held])
+    W_held = ap.with_coulomb(W_all[test_idx].reshape(len(test_idx) * dof, -1), coulomb[test_idx])
     cad_theta = np.concatenate([body_parameters(cad).ravel(), cad_joint])
-    pred = (W_held @ found.theta).reshape(len(held), dof)
-    pred_cad = (ap.with_coulomb(W_held, sign[held]) @ cad_theta).reshape(len(held), dof)
-    heldout = (tau[held] - pred, tau[held] - pred_cad, np.ptp(tau[held], axis=0))
+    pred = (W_held @ found.theta).reshape(len(test_idx), dof)
+    pred_cad = (ap.with_coulomb(W_held, sign[test_idx]) @ cad_theta).reshape(len(test_idx), dof)
+    heldout = (tau[test_idx] - pred, tau[test_idx] - pred_cad, np.ptp(tau[test_idx], axis=0))
     return ArmModelFit(
         links=tuple(
             _link_fit(n, k, c) for n, k, c in zip(lay.links, links, found.links, strict=True)
@@ -184,17 +192,18 @@ def light_regressor(cad: UrdfModel, f: MotionFilters, position: Arr) -> Arr:
 def _turn_speeds(
     filters: tuple[MotionFilters, MotionFilters],
     raw: tuple[Arr, Arr, Arr, Arr],
-    fitted: tuple[Arr, Arr, NDArray[np.intp], int],
+    fitted: tuple[Arr, Arr, NDArray[np.intp], int, NDArray[np.bool_]],
     bs: ap.BaseSet,
     beta: Arr,
     lay: ap.Layout,
 ) -> list[float]:
     """Each joint's ``v_c`` (``arm_friction.turn_speed``) on the effort the fitted rigid body and
     armature leave; ``raw``: positions, efforts, light velocity, the light motion's regressor
-    (``light_regressor``); ``fitted``: W, y, samples and the held-out part's start."""
+    (``light_regressor``); ``fitted``: W, y, samples, the held-out part's start and the samples
+    the wide filters' fit may use (``MotionFilters.fit_rows``)."""
     f, wide = filters
     position, effort, v_light, light = raw
-    W, y, idx, split = fitted
+    W, y, idx, split, live_w = fitted
     n, dof = position.shape
     rigid = np.zeros(lay.size)  # the fitted rigid body and armature, no friction
     keep = bs.base < lay.rigid + dof
@@ -207,6 +216,7 @@ def _turn_speeds(
     else:
         _, v_w, _ = wide.motion(position)
         idx_w = np.arange(2 * wide.window, split, wide.step)
+        idx_w = idx_w[live_w[idx_w]]
         W_w = wide.smooth(light)[idx_w].reshape(len(idx_w) * dof, -1)
         r_w = np.zeros((n, dof))
         r_w[idx_w] = wide.effort(effort)[idx_w] - (W_w @ rigid).reshape(-1, dof)

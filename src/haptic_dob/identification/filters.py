@@ -134,6 +134,11 @@ class MotionFilters:
                 out[max(0, a - reach) : b + reach] = True
         return out
 
+    def fit_rows(self, stamps_ns: NDArray[np.int64], speed: Arr) -> NDArray[np.bool_]:
+        """Samples whose filters reach neither a lost state nor a stretch held still (``speed``:
+        the fastest joint's, rad/s): the ones an arm's fit may use."""
+        return self.contiguous(stamps_ns) & ~self.held(speed, MIN_SPEED, HELD_S)
+
     def contiguous(self, stamps_ns: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Samples whose filters' support holds no gap in the stamps (a step of more than 1.5
         periods: states a driver or the network lost). The filters take the samples as one

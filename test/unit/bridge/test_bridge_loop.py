@@ -175,7 +175,7 @@ def test_the_drivers_clock_may_be_another_one(system: bool) -> None:
     for k, extra in enumerate([0.3e-3, 40e-6, 0.1e-3, 5e-3]):
         now = 2.0 + k * 1e-3 + extra
         at = clock.heard(off + k * T, now, round(now * 1e9) if system else None)
-    assert at == pytest.approx(2.0 + 3e-3 + 40e-6) and clock.age_s == 0.0
+    assert at == pytest.approx(2.0 + 3e-3 + 40e-6) and math.isnan(clock.age_s)
     later = clock.heard(off + 10 * T, 2.02, 2_020_000_000 if system else None)
     assert later == pytest.approx(2.0 + 10e-3 + 40e-6)
 
@@ -203,6 +203,27 @@ def test_on_one_clock_a_states_instant_is_its_stamp() -> None:
     b.on_command(cmd(4, 2.0, 0.0, 0.0), t3 + 2e-3 - 50e-6)  # before state 5's
     assert heard(5, t3 + 2e-3 + 200e-6) == 2.0
     assert (b.on_time, b.late) == (1, 1) and b.counts()["state_age_ms"] == pytest.approx(0.2)
+
+
+def test_one_clock_is_told_by_an_age_under_a_period_and_then_kept() -> None:
+    """A driver 5 ms behind this clock at 1 kHz (its states' least age 5.04 ms): not one clock,
+    instants the earliest the states could be heard. One stamping on this clock (least age
+    40 us) is, and stays so when every state of a later stretch arrives 3 ms old."""
+    behind, here = DriverClock(1e-3), DriverClock(1e-3)
+    for k in range(3):
+        now = 2.0 + k * 1e-3 + 40e-6
+        now_ns = round(now * 1e9)
+        at = behind.heard(now_ns - 5_000_000 - 40_000, now, now_ns)
+        assert at == pytest.approx(now)
+        at = here.heard(now_ns - 40_000, now, now_ns)
+        assert at == pytest.approx(now - 40e-6)
+    assert math.isnan(behind.age_s) and here.age_s == pytest.approx(40e-6)
+    for k in range(3, 3 + 2 * DriverClock.BLOCK):
+        now = 2.0 + k * 1e-3 + 3e-3
+        assert here.heard(round((now - 3e-3) * 1e9), now, round(now * 1e9)) == pytest.approx(
+            now - 3e-3
+        )
+    assert here.one_clock and here.age_s == pytest.approx(3e-3)
 
 
 def test_late_commands_are_counted_per_state() -> None:

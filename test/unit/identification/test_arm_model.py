@@ -124,7 +124,7 @@ def test_too_little_excitation_is_refused_naming_what_it_does_not_see(config) ->
     [
         ("no effort", "carries no effort for joint 'joint1'"),
         ("other joints", "has no joint 'joint1'"),
-        ("still", "too little motion: 0 samples to fit, 0 held out clear of stretches"),
+        ("still", "too little motion: 0 samples to fit, 0 held out, once the filters"),
     ],
 )
 def test_a_bag_it_cannot_use_gets_one_line_and_exit_2(tmp_path, config, kind, message) -> None:
