@@ -29,11 +29,10 @@ from haptic_dob.identification.arm_consistent import (
     ConsistentFit,
     Link,
     fit_consistent,
-    inertia_about_com,
     pseudo_inertia,
 )
 from haptic_dob.identification.arm_friction import coulomb_term, turn_filters, turn_speed
-from haptic_dob.identification.arm_model_report import ArmModelFit, JointFit, LinkFit
+from haptic_dob.identification.arm_model_report import ArmModelFit, joint_fits, link_fit
 from haptic_dob.identification.arm_normal import Normal, condition_number, solve, square_root
 from haptic_dob.identification.arm_urdf import LinkInertial, link_inertials
 from haptic_dob.identification.filters import (
@@ -160,9 +159,9 @@ def identify_arm_model(
     heldout = (tau[test_idx] - pred, tau[test_idx] - pred_cad, np.ptp(tau[test_idx], axis=0))
     return ArmModelFit(
         links=tuple(
-            _link_fit(n, k, c) for n, k, c in zip(lay.links, links, found.links, strict=True)
+            link_fit(n, k, c) for n, k, c in zip(lay.links, links, found.links, strict=True)
         ),
-        joints=_joint_fits(lay.joints, found, speeds, heldout),
+        joints=joint_fits(lay.joints, found, speeds, heldout),
         holdout=holdout,
         samples=len(idx),
         condition_number=condition_number(normal.total()[0], bs.base),
@@ -277,48 +276,3 @@ def _check(names: Sequence[str], links: Sequence[Link], found: ConsistentFit) ->
                 f"{name}: the fit is not physically consistent (mass {m:.4g} kg, centre of "
                 f"mass {np.round(c, 4).tolist()} m, pseudo-inertia eigenvalue {low:.3g})"
             )
-
-
-def _link_fit(name: str, link: Link, found: tuple[float, Arr, Arr]) -> LinkFit:
-    m, c, sigma = found
-    inertia = inertia_about_com(sigma)
-    xx, xy, xz = (float(v) for v in inertia[0])
-    yy, yz, zz = float(inertia[1, 1]), float(inertia[1, 2]), float(inertia[2, 2])
-    return LinkFit(
-        link=name,
-        mass=float(m),
-        com=_triple(c),
-        inertia=(xx, xy, xz, yy, yz, zz),
-        cad_mass=link.mass,
-        cad_com=_triple(link.com),
-        box_lo=_triple(link.lo),
-        box_hi=_triple(link.hi),
-        pseudo_inertia_min=float(np.linalg.eigvalsh(pseudo_inertia(m, c, sigma))[0]),
-    )
-
-
-def _triple(v: Arr) -> tuple[float, float, float]:
-    return (float(v[0]), float(v[1]), float(v[2]))
-
-
-def _joint_fits(
-    joints: Sequence[str],
-    found: ConsistentFit,
-    speeds: Sequence[float],
-    heldout: tuple[Arr, Arr, Arr],
-) -> tuple[JointFit, ...]:
-    e, e_cad, span = heldout
-    rms, rms_cad = np.sqrt(np.mean(e * e, axis=0)), np.sqrt(np.mean(e_cad * e_cad, axis=0))
-    return tuple(
-        JointFit(
-            joint=name,
-            armature=float(found.armature[j]),
-            viscous=float(found.viscous[j]),
-            coulomb=float(found.coulomb[j]),
-            coulomb_speed=float(speeds[j]),
-            heldout_rms=float(rms[j]),
-            heldout_rms_cad=float(rms_cad[j]),
-            torque_span=float(span[j]),
-        )
-        for j, name in enumerate(joints)
-    )

@@ -3,14 +3,25 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
+from haptic_dob.identification.arm_consistent import (
+    ConsistentFit,
+    Link,
+    inertia_about_com,
+    pseudo_inertia,
+)
 from haptic_dob.identification.arm_urdf import JointDynamics, LinkInertial, rewrite_urdf
 
 Triple = tuple[float, float, float]
+
+
+Arr = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -133,3 +144,51 @@ def table(fit: ArmModelFit, bag: str) -> str:
             f"not identifiable on their own (held toward CAD): {', '.join(fit.unidentifiable)}"
         )
     return "\n".join(rows)
+
+
+def link_fit(name: str, link: Link, found: tuple[float, Arr, Arr]) -> LinkFit:
+    """Link ``name``'s fitted mass, centre of mass and inertia beside its CAD values."""
+    m, c, sigma = found
+    inertia = inertia_about_com(sigma)
+    xx, xy, xz = (float(v) for v in inertia[0])
+    yy, yz, zz = float(inertia[1, 1]), float(inertia[1, 2]), float(inertia[2, 2])
+    return LinkFit(
+        link=name,
+        mass=float(m),
+        com=_triple(c),
+        inertia=(xx, xy, xz, yy, yz, zz),
+        cad_mass=link.mass,
+        cad_com=_triple(link.com),
+        box_lo=_triple(link.lo),
+        box_hi=_triple(link.hi),
+        pseudo_inertia_min=float(np.linalg.eigvalsh(pseudo_inertia(m, c, sigma))[0]),
+    )
+
+
+def _triple(v: Arr) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def joint_fits(
+    joints: Sequence[str],
+    found: ConsistentFit,
+    speeds: Sequence[float],
+    heldout: tuple[Arr, Arr, Arr],
+) -> tuple[JointFit, ...]:
+    """Each joint's friction, armature and held-out residual (``heldout``: the errors
+    identified and CAD, and the torque spans)."""
+    e, e_cad, span = heldout
+    rms, rms_cad = np.sqrt(np.mean(e * e, axis=0)), np.sqrt(np.mean(e_cad * e_cad, axis=0))
+    return tuple(
+        JointFit(
+            joint=name,
+            armature=float(found.armature[j]),
+            viscous=float(found.viscous[j]),
+            coulomb=float(found.coulomb[j]),
+            coulomb_speed=float(speeds[j]),
+            heldout_rms=float(rms[j]),
+            heldout_rms_cad=float(rms_cad[j]),
+            torque_span=float(span[j]),
+        )
+        for j, name in enumerate(joints)
+    )
