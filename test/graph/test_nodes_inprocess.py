@@ -10,6 +10,7 @@ from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
+from haptic_dob.launcher import write_params_file
 from haptic_dob.nodes.channel_node import ChannelNode
 from haptic_dob.nodes.controller_node import ControllerNode
 from haptic_dob.nodes.environment_node import EnvironmentNode
@@ -504,4 +505,23 @@ def test_the_command_input_is_reliable_and_sensor_streams_best_effort(
         assert reliabilities() == {policy[asked or default]}
     finally:
         node.destroy_node()
+        rclpy.try_shutdown(context=ctx)
+
+
+@pytest.mark.parametrize("token", ["4111751691456e08", "0123", "1e5", "true"])
+def test_a_number_like_token_in_the_launch_params_file_reaches_the_node_as_text(
+    token: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """rcl types an unquoted scalar by its look: the launcher's file quotes its strings."""
+    path = write_params_file({"controller_node": {"command_token": token}}, tmp_path)
+    monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
+    ctx = Context()
+    rclpy.init(context=ctx, args=["--ros-args", "--params-file", str(path)])
+    try:
+        node = ControllerNode(context=ctx)
+        try:
+            assert node.get_parameter("command_token").value == token
+        finally:
+            node.destroy_node()
+    finally:
         rclpy.try_shutdown(context=ctx)

@@ -5,12 +5,11 @@ from __future__ import annotations
 import copy
 from collections.abc import Mapping
 
-import yaml
-
 from haptic_dob.identification.arm_friction import ArmFrictionFit
 from haptic_dob.identification.filters import plus_minus
 from haptic_dob.identification.one_dof import SlideFit
 from haptic_dob.identification.per_axis import AxesFit
+from haptic_dob.runtime.params_file import dump_params
 
 #: why a fit has no Coulomb friction: the step method separates it from the swings' decay only
 #: where the effort holds the rendered spring (it then falls back to the thesis's formulas)
@@ -40,11 +39,10 @@ MODEL_NODES = ("observer_node", "controller_node")
 
 def model_yaml(params: Mapping[str, object], what: str, bag: str) -> str:
     """A params file that sets ``params`` of the observer's and the controller's model (each
-    node its own copy of a list: YAML would alias a shared one, and rcl refuses aliases)."""
+    node its own copy of a list, written without aliases, which rcl refuses)."""
     head = f"# identified from {bag} by haptic-identify ({what})\n"
     doc = {f"/**/{n}": {"ros__parameters": copy.deepcopy(dict(params))} for n in MODEL_NODES}
-    body: str = yaml.safe_dump(doc, sort_keys=False)
-    return head + body
+    return head + dump_params(doc)
 
 
 def arm_table(fit: ArmFrictionFit, bag: str) -> str:

@@ -11,8 +11,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from haptic_dob.core.command_authority import new_token
 from haptic_dob.errors import InputError
 from haptic_dob.nodes.registry import NODES
@@ -20,6 +18,7 @@ from haptic_dob.runtime import cpus
 from haptic_dob.runtime.configs import urdf_beside
 from haptic_dob.runtime.cpu_latency import NO_REQUEST
 from haptic_dob.runtime.params import load_node_params
+from haptic_dob.runtime.params_file import dump_params
 
 
 def resolved_params(
@@ -141,5 +140,5 @@ def write_params_file(params: dict[str, Any], directory: Path) -> Path:
         key = "/**" if name == "/**" else f"/**/{name}"
         doc[key] = {"ros__parameters": values}
     path = directory / "params.yaml"
-    path.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
+    path.write_text(dump_params(doc), encoding="utf-8")
     return path

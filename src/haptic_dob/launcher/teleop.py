@@ -31,6 +31,7 @@ from haptic_dob.launcher.process_plan import ProcessSpec, executable
 from haptic_dob.launcher.robot_description import fetch, fill
 from haptic_dob.launcher.supervise import RUN_ENDS, launch, set_rt_priority
 from haptic_dob.nodes.registry import CONTAINER, NODES
+from haptic_dob.runtime.params_file import dump_params
 from haptic_dob.teleop.graph import (
     NAMESPACES,
     RECORDER,
@@ -83,18 +84,11 @@ def teleop_params(
     return out
 
 
-class _Plain(yaml.SafeDumper):  # type: ignore[misc]  # PyYAML ships without stubs here
-    """YAML without anchors: rcl's parser refuses aliases (nodes share values, such as lists)."""
-
-    def ignore_aliases(self, data: Any) -> bool:
-        return True
-
-
 def write_teleop_params(params: Mapping[str, Mapping[str, Any]], directory: Path) -> Path:
     """The params file: every node's parameters under its full name (``/master/device_node``)."""
     doc = {f"/{name}": {"ros__parameters": dict(values)} for name, values in params.items()}
     path = directory / "params.yaml"
-    path.write_text(yaml.dump(doc, Dumper=_Plain, sort_keys=False), encoding="utf-8")
+    path.write_text(dump_params(doc), encoding="utf-8")
     return path
 
 

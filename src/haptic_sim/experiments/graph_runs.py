@@ -28,10 +28,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from haptic_dob.launcher import add_recorder
 from haptic_dob.runtime.params import load_node_params
+from haptic_dob.runtime.params_file import dump_params
 from haptic_sim.experiments.records import Cell
 
 COMPLETE = "complete"
@@ -94,7 +93,7 @@ def _params_yaml(run: GraphRun, bag: Path) -> str:
     params = {k: dict(v) for k, v in run.params.items()}
     add_recorder(params, str(bag), "mcap")
     doc = {"/**" if k == "/**" else f"/**/{k}": {"ros__parameters": v} for k, v in params.items()}
-    return str(yaml.safe_dump(doc, sort_keys=False))
+    return dump_params(doc)
 
 
 class Stopper:
