@@ -14,9 +14,8 @@ import secrets
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from haptic_dob.runtime.params import load_sections
+from haptic_dob.runtime.params_file import dump_params
 from support.drivers.run import Truth, start
 from support.drivers.stand_in import Answer, LoopStandIn
 from support.paths import BIN, ROOT
@@ -34,7 +33,7 @@ def bridge_params(config: Path, overrides: dict[str, Any], directory: Path) -> P
     if "urdf_path" in values and not Path(values["urdf_path"]).is_absolute():
         values["urdf_path"] = str(config.parent / values["urdf_path"])
     path = directory / "bridge_params.yaml"
-    path.write_text(yaml.safe_dump({"/**/bridge_node": {"ros__parameters": values}}))
+    path.write_text(dump_params({"/**/bridge_node": {"ros__parameters": values}}))
     return path
 
 

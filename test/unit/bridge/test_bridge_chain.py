@@ -44,6 +44,8 @@ TOUCH_HAND = {
     for k, v in load_node_params(plants.TOUCH_SIM)["device_node"].items()
     if k.startswith("hand.")
 }
+#: the simulated Touch's count (rad): config/phantom_omni_sim.yaml's
+TOUCH_COUNT_RAD = load_node_params(plants.TOUCH_SIM)["device_node"]["arm.encoder_resolution_rad"]
 
 
 def session(*files: Path, over: dict[str, dict[str, Any]] | None = None) -> dict[str, Any]:
@@ -161,12 +163,14 @@ def touch_dob(
 ) -> tuple[float, float]:
     """The Touch's DOB session with ``model`` set on the nodes that assume one (as ``--set``
     does), the hand pushing the stylus onto the floor: the estimate's RMS error in contact and
-    the true force's span there (N). The
-    plant's encoder counts (and the bridge's ``state.encoder_resolution``) are its config's
-    unless ``encoder_resolution_rad`` is given."""
+    the true force's span there (N). The plant's encoder counts (and the bridge's
+    ``state.encoder_resolution``, the elbow's two counts as the config has them) are the
+    configs' unless ``encoder_resolution_rad`` is given."""
     over = {n: {**model} for n in ("bridge_node", "observer_node", "controller_node")}
     if encoder_resolution_rad is not None:
-        over["bridge_node"]["state.encoder_resolution"] = [encoder_resolution_rad]
+        told = node_view(session(config), "bridge_node")["state.encoder_resolution"]
+        scale = encoder_resolution_rad / TOUCH_COUNT_RAD
+        over["bridge_node"]["state.encoder_resolution"] = [scale * r for r in told]
     over["controller_node"]["mode"] = "DOB"
     dob = session(config, over=over)
     pusher = plants.touch(500.0, 0, TOUCH_HAND, (0.0, 0.0, -1.0), encoder_resolution_rad)
@@ -230,7 +234,7 @@ def test_touch_estimate_within_5_percent_with_finer_encoder_counts() -> None:
     """What limits the Touch's estimate to 6 % is its encoder: the same DOB session, on the
     plant's truth, with counts ten times finer (4e-5 rad, and the bridge's window told so; the
     Touch's are about 4e-4, its tip's 0.055 mm) is within issue 31's 5 % of the true force's
-    span (measured 4.15 %). A model error or the bridge's timing would keep it above (6.1 % at
+    span (measured 4.1 %). A model error or the bridge's timing would keep it above (6.1 % at
     the Touch's counts)."""
     truth = plants.touch(500.0, 0, {"behaviour": "none"}, (0.0, 0.0, -1.0)).truth()
     plant_truth = truth_model(truth)
