@@ -82,12 +82,11 @@ LOOP = {
 #: one core it fell behind (under 1 % of its commands on time) and strays' commands went
 #: unread, as when its 1000-deep input queue overflows: 139 and 147 of 150 taken in 2 of 10
 #: runs, 41-59 in 6 of 6 with the single-threaded executor
-RATE = [f"{n}:rate_hz=250.0" for n in ("device_node", "environment_node", "observer_node")]
+LOOP_NODES = ("device_node", "environment_node", "observer_node", "controller_node")
 SETS = [
     "device_node:clock_mode=realtime",
     "device_node:duration_s=0.0",
-    *RATE,
-    "controller_node:rate_hz=250.0",
+    *(f"{n}:rate_hz=250.0" for n in LOOP_NODES),
 ]
 
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import copy
 from collections.abc import Mapping
 
 from haptic_dob.identification.arm_friction import ArmFrictionFit
@@ -38,10 +37,10 @@ MODEL_NODES = ("observer_node", "controller_node")
 
 
 def model_yaml(params: Mapping[str, object], what: str, bag: str) -> str:
-    """A params file that sets ``params`` of the observer's and the controller's model (each
-    node its own copy of a list, written without aliases, which rcl refuses)."""
+    """A params file that sets ``params`` of the observer's and the controller's model
+    (``dump_params``: a list both share is written twice, never as an alias rcl refuses)."""
     head = f"# identified from {bag} by haptic-identify ({what})\n"
-    doc = {f"/**/{n}": {"ros__parameters": copy.deepcopy(dict(params))} for n in MODEL_NODES}
+    doc = {f"/**/{n}": {"ros__parameters": dict(params)} for n in MODEL_NODES}
     return head + dump_params(doc)
 
 
