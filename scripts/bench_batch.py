@@ -5,10 +5,12 @@
 
 from __future__ import annotations
 
+import math
 import statistics
 import time
 import timeit
 
+from haptic_dob.bridge.velocity import KalmanVelocity, WindowVelocity
 from haptic_dob.core.models import SlideModel
 from haptic_dob.core.observers.disturbance import DisturbanceObserver
 from haptic_sim.slide.session import SessionConfig, run_session
@@ -43,6 +45,35 @@ def bench_observer_update(repeat: int) -> str:
         timeit.timeit(lambda: obs.update(q, qd, tau), number=n) / n * 1e6 for _ in range(repeat)
     ]
     return f"median {statistics.median(runs):.2f} us per update (min {min(runs):.2f})"
+
+
+def bench_velocity(repeat: int) -> str:
+    """The bridge's velocity from a Touch's three joints' counts (4e-4, 4e-4, 8e-4 rad, 500 Hz,
+    the joints swinging 0.05 rad at 3, 5 and 7 rad/s): microseconds per state, the adaptive
+    window and the Kalman filter (density 800)."""
+    counts = [4e-4, 4e-4, 8e-4]
+    n = 5000
+    states = [
+        tuple(
+            c * round(0.05 * math.sin(k * 0.002 * w) / c)
+            for c, w in zip(counts, (3, 5, 7), strict=True)
+        )
+        for k in range(n)
+    ]
+    out = []
+    for name, make in (
+        ("window (8 periods)", lambda: WindowVelocity(counts, 8, 0.01)),
+        ("Kalman", lambda: KalmanVelocity(counts, [800.0] * 3, 0.002, 0.01)),
+    ):
+        runs = []
+        for _ in range(repeat):
+            est = make()
+            t0 = time.perf_counter()
+            for k, q in enumerate(states):
+                est.update(k * 2_000_000, q)
+            runs.append((time.perf_counter() - t0) / n * 1e6)
+        out.append(f"{name} median {statistics.median(runs):.1f} us per state")
+    return "; ".join(out)
 
 
 def batch_cycle_us(mode: str = "DOB", kf: float = 1.0, seconds: float = 10.0) -> float:

@@ -76,6 +76,9 @@ ROWS = [
          "factor and one cycle (the batch cycle)", "benchmarks.py", "batch", "--repeat", "5"),
     _row("core", "one slide observer update (checks, implicit update, clip)",
          "benchmarks.py", "observer", "--repeat", "5"),
+    _row("core", "the bridge's velocity from a position-only state, a Touch's three joints' "
+         "counts at 500 Hz: the adaptive window and the Kalman filter, per state",
+         "benchmarks.py", "velocity", "--repeat", "5"),
     _row("models", "one PHANToM 1.5 observer update (pinocchio), and update + wrench",
          "bench_models.py", "phantom", "--repeat", "9"),
     _row("models", "one 7-DOF URDF arm observer update (`config/urdf/arm7.urdf`)",

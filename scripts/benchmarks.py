@@ -18,7 +18,7 @@ from pathlib import Path
 # process), bench_hop and bench_pattern (DDS floors), bench_graph (the launched node graph),
 # bench_timer_floor (the machine's own stalls), bench_margin (the graph against its floors)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_batch import bench_batch_session, bench_observer_update
+from bench_batch import bench_batch_session, bench_observer_update, bench_velocity
 from bench_bridge import CPUS, bench_bridge
 from bench_graph import (
     GRAPH_ARGS,
@@ -54,6 +54,7 @@ def machine() -> str:
 BENCHMARKS: dict[str, Callable[[int], str]] = {
     "batch": bench_batch_session,
     "observer": bench_observer_update,
+    "velocity": bench_velocity,
     "lockstep": bench_lockstep,
     "lockstep-composed": bench_lockstep_composed,
     "lockstep-processes": bench_lockstep_processes,

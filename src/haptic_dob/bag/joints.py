@@ -35,10 +35,14 @@ class JointStates:
 
 
 def read_joints(
-    path: str | Path, topic: str = "joint_states", joints: Sequence[str] | None = None
+    path: str | Path,
+    topic: str = "joint_states",
+    joints: Sequence[str] | None = None,
+    need_effort: bool = True,
 ) -> JointStates:
     """Stamps, positions and efforts of ``joints`` (None: every joint of the first message, in
-    its order) on ``topic`` of a bag; ``BagError`` with one line when they are not there.
+    its order) on ``topic`` of a bag; ``BagError`` with one line when they are not there (the
+    efforts NaN where a message has none and ``need_effort`` is False).
 
     Messages that do not name every wanted joint (a topic that interleaves an arm's and a
     gripper's states) are left out; a driver that names no joints gives its joints in order.
@@ -69,12 +73,12 @@ def read_joints(
                 seen.update(dict.fromkeys(names))
             if idx is None:
                 continue  # a message of other joints
-            _check_fields(msg, idx, wanted, shown, name)
+            _check_fields(msg, idx, wanted, shown, name, need_effort)
             st = msg.header.stamp
             stamps.append(st.sec * 1_000_000_000 + st.nanosec)
             received.append(t)
             pos.append([float(msg.position[i]) for i in idx])
-            eff.append([float(msg.effort[i]) for i in idx])
+            eff.append([float(msg.effort[i]) if i < len(msg.effort) else np.nan for i in idx])
     if not stamps:
         if last_names is None:
             raise BagError(f"{shown}: {name} holds no messages; topics: {listing(topics)}")
@@ -116,12 +120,15 @@ def _indices(
     return [names.index(j) for j in wanted]
 
 
-def _check_fields(msg: Any, idx: list[int], wanted: list[str], shown: str, topic: str) -> None:
-    """A position and an effort for every wanted joint, or one line naming the first missing."""
+def _check_fields(
+    msg: Any, idx: list[int], wanted: list[str], shown: str, topic: str, need_effort: bool
+) -> None:
+    """A position (and an effort, if needed) for every wanted joint, or one line naming the
+    first missing."""
     for i, joint in zip(idx, wanted, strict=True):
         if len(msg.position) <= i:
             raise BagError(f"{shown}: {topic} has no position for joint {joint!r}")
-        if len(msg.effort) <= i:
+        if need_effort and len(msg.effort) <= i:
             raise BagError(
                 f"{shown}: {topic} carries no effort for joint {joint!r}; identification "
                 "needs the applied effort (the driver's effort field)"

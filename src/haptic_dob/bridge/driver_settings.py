@@ -148,6 +148,21 @@ class StateSettings:
             bounds=(1, 64),
         ),
     )
+    velocity_jerk_psd: list[float] | tuple[float, ...] = field(
+        default_factory=lambda: [0.0],
+        metadata=param(
+            description="each joint's white-jerk density (units^2/s^5); 0 = the adaptive window",
+            bounds=(0.0, 1e12),
+            details=(
+                "One for all joints or one each. Set (> 0, with encoder_resolution) for a "
+                "differenced velocity by a steady-state Kalman filter per joint in place of the "
+                "window: constant acceleration driven by white jerk of this "
+                "density, the counts' rounding as its noise. Less lag than the window at the "
+                "same noise. Identify it from a session with the hand on the device: "
+                "haptic-identify BAG --velocity-noise (docs/devices.md)."
+            ),
+        ),
+    )
     effort: str = field(
         default="",
         metadata=param(

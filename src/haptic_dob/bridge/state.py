@@ -19,7 +19,7 @@ import numpy as np
 
 from haptic_dob.bridge.driver_settings import FrameSettings, StateSettings
 from haptic_dob.bridge.settings import per_element
-from haptic_dob.bridge.velocity import Velocity, VelocityFilter, WindowVelocity
+from haptic_dob.bridge.velocity import KalmanVelocity, Velocity, VelocityFilter, WindowVelocity
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.base import DeviceModel
 
@@ -34,14 +34,27 @@ class DriverState(NamedTuple):
     effort: tuple[float, ...] | None
 
 
-def velocity_estimator(state: StateSettings, n: int, max_gap_s: float) -> Velocity:
-    """The settings' estimator of a differenced velocity for ``n`` joints: the adaptive window
-    where ``state.encoder_resolution`` is set, else the low-pass."""
+def velocity_estimator(state: StateSettings, n: int, period_s: float, max_gap_s: float) -> Velocity:
+    """The settings' estimator of a differenced velocity for ``n`` joints: the Kalman filter
+    where ``state.velocity_jerk_psd`` is set, else the adaptive window where
+    ``state.encoder_resolution`` is, else the low-pass."""
     counts = per_element(
         "state.encoder_resolution", state.encoder_resolution, n, positive=False, of="joint"
     )
     if not all(math.isfinite(c) and c >= 0.0 for c in counts):
         raise ValueError(f"state.encoder_resolution must be >= 0 (0: the low-pass), got {counts}")
+    psd = per_element("state.velocity_jerk_psd", state.velocity_jerk_psd, n, False, of="joint")
+    if not all(math.isfinite(p) and p >= 0.0 for p in psd):
+        raise ValueError(f"state.velocity_jerk_psd must be >= 0 (0: no Kalman filter), got {psd}")
+    if any(psd) and not all(psd):
+        raise ValueError(
+            f"state.velocity_jerk_psd: set every joint's (> 0) or none (0), got {list(psd)}"
+        )
+    if any(psd) and not all(counts):
+        raise ValueError(
+            "state.velocity_jerk_psd needs every joint's state.encoder_resolution (> 0): the "
+            "Kalman filter takes the counts' rounding as its noise"
+        )
     if not any(counts):
         return VelocityFilter(state.velocity_cutoff_hz, max_gap_s)
     if not all(counts):
@@ -49,6 +62,8 @@ def velocity_estimator(state: StateSettings, n: int, max_gap_s: float) -> Veloci
             f"state.encoder_resolution: set every joint's (> 0) or none (0: the low-pass), got "
             f"{list(counts)}"
         )
+    if any(psd):
+        return KalmanVelocity(counts, psd, period_s, max_gap_s)
     return WindowVelocity(counts, state.velocity_window_samples, max_gap_s)
 
 
@@ -96,7 +111,7 @@ class StateReader:
         self.axis_signs = tuple(frame.signs)
         self._map = JointMap(self.driver_joints)
         self._gain = [s * self.scale for s in self.signs]
-        self.velocity = velocity_estimator(state, n, 5.0 * period_s)
+        self.velocity = velocity_estimator(state, n, period_s, 5.0 * period_s)
 
     def joints(
         self, stamp_ns: int, names: Sequence[str], position: Any, velocity: Any, effort: Any
@@ -130,7 +145,7 @@ class StateReader:
         ``state.encoder_resolution`` (a count set too coarse makes the velocity lag; up to twice
         the true count passes unsaid). None for a pose state."""
         v = self.velocity
-        if self.pose or not isinstance(v, WindowVelocity):
+        if self.pose or not isinstance(v, WindowVelocity | KalmanVelocity):
             return []  # a pose's axes come through kinematics: their steps are no counts
         return [
             f"state.encoder_resolution: {self.driver_joints[j]} stepped {step:.3g} between two "

@@ -1,4 +1,5 @@
-"""Velocity from a driver's positions alone: a low-passed difference, or an adaptive window.
+"""Velocity from a driver's positions alone: a low-passed difference, an adaptive window, or a
+Kalman filter.
 
 ``VelocityFilter``: the backward difference over the stamps' interval, then a first-order
 low-pass. ``WindowVelocity``: first-order adaptive windowing (Janabi-Sharifi, Hayward and Chen
@@ -6,8 +7,10 @@ low-pass. ``WindowVelocity``: first-order adaptive windowing (Janabi-Sharifi, Ha
 counts coarse against the motion between samples: per joint, the slope of the least-squares
 line through the longest run of recent samples (at most ``max_samples``) that all lie closer
 than half a count to it. Slow motion gets a long window (little noise), fast motion a short one
-(little lag). Both take (stamp ns, positions) and restart from zero velocity after an interval
-<= 0 or over ``max_gap_s``.
+(little lag). ``KalmanVelocity``: the steady-state Kalman filter of ``haptic_dob.core.
+kalman_velocity`` per joint, its jerk density identified from a session (``haptic-identify
+--velocity-noise``). Each takes (stamp ns, positions) and restarts from zero velocity after an
+interval <= 0 or over ``max_gap_s``.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from collections import deque
 from collections.abc import Sequence
 from typing import Protocol
 
+from haptic_dob.core.kalman_velocity import KalmanState, steady_gain
 from haptic_msgs_py.stamps import NS_PER_S
 
 
@@ -109,6 +113,65 @@ class WindowVelocity:
         """Forget the history: the next sample starts again from zero velocity."""
         self._t.clear()
         self._q.clear()
+
+
+class KalmanVelocity:
+    """Each joint's steady-state Kalman filter (``haptic_dob.core.kalman_velocity``): plain
+    Python on the command's path.
+
+    Args:
+        resolution: each joint's count (position units, > 0): the rounding's noise.
+        jerk_psd: each joint's white-jerk density (units^2/s^5, > 0).
+        period_s: the driver's nominal period, the gain's.
+        max_gap_s: an interval <= 0 or longer restarts from zero velocity.
+    """
+
+    def __init__(
+        self,
+        resolution: Sequence[float],
+        jerk_psd: Sequence[float],
+        period_s: float,
+        max_gap_s: float,
+    ) -> None:
+        self.gains = tuple(
+            steady_gain(p, c, period_s) for p, c in zip(jerk_psd, resolution, strict=True)
+        )
+        self.half = tuple(0.5 * float(r) * (1.0 - 1e-9) for r in resolution)
+        self.max_gap_s = max_gap_s
+        self._joints: list[KalmanState] = []
+        self._stamp = 0
+        self._q: tuple[float, ...] = ()
+        self._prev: tuple[float, ...] = ()
+        self._finer: set[int] = set()
+
+    def update(self, stamp_ns: int, q: Sequence[float]) -> tuple[float, ...]:
+        """The velocity (per s) at sample ``stamp_ns`` with positions ``q``."""
+        dt = (stamp_ns - self._stamp) / NS_PER_S
+        self._stamp = stamp_ns
+        self._prev, self._q = self._q, tuple(q)
+        if not self._joints or not 0.0 < dt <= self.max_gap_s:
+            self._joints = [KalmanState(g, y) for g, y in zip(self.gains, q, strict=True)]
+            self._prev = ()
+            return (0.0,) * len(q)
+        out = []
+        for f, y in zip(self._joints, q, strict=True):
+            f.update(dt, y)
+            out.append(f.qd)
+        return tuple(out)
+
+    def finer_steps(self) -> dict[int, float]:
+        """The joints whose newest step is under half their count, each once ever, with that
+        step (called off the command's path): a count set too coarse over-smooths."""
+        new: dict[int, float] = {}
+        for j, (a, b) in enumerate(zip(self._q, self._prev, strict=False)):
+            if 0.0 < abs(a - b) < self.half[j] and j not in self._finer:
+                self._finer.add(j)
+                new[j] = abs(a - b)
+        return new
+
+    def reset(self) -> None:
+        """Forget the state: the next sample starts again from zero velocity."""
+        self._joints = []
 
 
 def _slope(tau: list[float], y: list[float], half: float) -> float:

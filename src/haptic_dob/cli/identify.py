@@ -1,17 +1,17 @@
 """``haptic-identify BAG``: the 1-DOF device model (mass, viscous and Coulomb friction) from a bag.
 
-Reads the joint states of a recorded session (MCAP or sqlite3; ours or ``ros2 bag record``'s;
+Reads a recorded session's joint states (MCAP or sqlite3; ours or ``ros2 bag record``'s;
 ``/joint_states`` alone is enough) and identifies ``m x'' + c x' + Fc sgn(x') = u`` by least
 squares (default) or by the step method under a virtual spring (``--method step``, or
 ``thesis_step`` for the thesis's formulas verbatim). ``--urdf FILE --tip-frame F``: an arm's
-joint friction beyond the URDF's rigid body (``identification.arm_friction``), judged on held-out
-data; with ``--inertial``, the arm's whole physically consistent model with each joint's armature
-and friction (``identification.arm_model``), written as a URDF by ``--write-urdf OUT``.
-``--axes X,Y,Z``: a Cartesian device per axis (``identification.per_axis``; a Force Dimension
-device: ``--axes fd_x,fd_y,fd_z``). Prints a table, or one JSON line (``--json``);
+joint friction beyond the URDF's rigid body (``identification.arm_friction``); with
+``--inertial``, the arm's whole physically consistent model (``identification.arm_model``),
+written as a URDF by ``--write-urdf OUT``. ``--axes X,Y,Z``: a Cartesian device per axis
+(``identification.per_axis``). ``--velocity-noise --counts C``: the bridge's Kalman velocity
+filter (``cli.identify_velocity``). Prints a table, or one JSON line (``--json``);
 ``--write-yaml FILE`` writes the model as the observer's and controller's params file
-(``slide.*``, ``point_mass.*`` or ``urdf.viscous_n_m_s_per_rad`` and ``urdf.coulomb_n_m``), to
-load after the session's config.
+(``slide.*``, ``point_mass.*`` or ``urdf.*`` friction; the bridge's for ``--velocity-noise``),
+to load after the session's config.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from pathlib import Path
 from haptic_dob.bag.joints import read_joint, read_joints
 from haptic_dob.cli.common import ArgumentParser, run
 from haptic_dob.cli.identify_tables import arm_table, axes_table, model_yaml, table
+from haptic_dob.cli.identify_velocity import velocity_command
 from haptic_dob.core.models import UrdfModel
 from haptic_dob.core.models._pinocchio_urdf import read_urdf
 from haptic_dob.errors import InputError
@@ -193,7 +194,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument(
         "--joints",
         help="with --urdf: comma-separated joints (default: the chain to the tip); the chain's "
-        "other joints are taken as still at zero",
+        "other joints are taken as still at zero. With --velocity-noise: the joints to read "
+        "(default: every joint of the first message)",
     )
     p.add_argument(
         "--turn-cutoff-hz",
@@ -223,7 +225,40 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="a Cartesian device: identify each of these joints (x, y, z order; fd_x,fd_y,fd_z "
         "for a Force Dimension device) as an axis of the point-mass model, by least squares",
     )
+    p.add_argument(
+        "--velocity-noise",
+        action="store_true",
+        help="the bridge's Kalman velocity filter: its jerk density from a session with the hand "
+        "moving the device (positions only), one for every joint that moved; needs --counts; "
+        "--write-yaml writes the bridge's state.encoder_resolution and state.velocity_jerk_psd",
+    )
+    p.add_argument(
+        "--counts",
+        metavar="C[,C...]",
+        help="with --velocity-noise: each joint's encoder count in the bag's units (one for all, "
+        "or one per joint: the bridge's state.encoder_resolution)",
+    )
     a = p.parse_args(argv)
+    if a.velocity_noise:
+        off = (
+            ("--urdf", a.urdf),
+            ("--tip-frame", a.tip_frame),
+            ("--joint", a.joint),
+            ("--turn-cutoff-hz", a.turn_cutoff_hz is not None),
+            ("--inertial", a.inertial),
+            ("--write-urdf", a.write_urdf),
+            ("--axes", a.axes),
+            ("--method", a.method != "least_squares"),
+        )
+        clash = [f for f, on in off if on]
+        if clash:
+            p.error(f"--velocity-noise fits the positions alone: leave out {', '.join(clash)}")
+        if not a.counts:
+            p.error("--velocity-noise needs --counts (the bridge's state.encoder_resolution)")
+        chosen = tuple(j for j in (a.joints or "").split(",") if j)
+        return run(lambda: velocity_command(a.bag, a.topic, chosen, a.counts, a.json, a.write_yaml))
+    if a.counts:
+        p.error("--counts goes with --velocity-noise")
     if a.axes is not None:
         given = (
             ("--urdf", a.urdf),
