@@ -21,6 +21,7 @@ from haptic_dob.identification.per_axis import identify_axes
 from haptic_dob.runtime.params import build, load_node_params, node_view
 from haptic_sim.device.batch import BatchRecord, run_batch
 from haptic_sim.point_mass.device import PointMassDeviceParams
+from support.cli import exit_code
 from support.joint_bags import write_joint_states
 from support.paths import ROOT
 
@@ -114,11 +115,7 @@ def test_a_bag_without_the_axes_is_refused_in_one_line(
 def test_bad_axes_options_are_refused(
     bag: Path, capsys: pytest.CaptureFixture[str], args: list[str], says: str
 ) -> None:
-    try:
-        code = main([str(bag), *args])
-    except SystemExit as exc:  # argparse's refusals
-        code = int(exc.code or 0)
-    assert code == 2
+    assert exit_code(main, [str(bag), *args]) == 2
     err = capsys.readouterr().err
     assert f"ERROR: {says}" in err or says in err
 

@@ -14,6 +14,7 @@ import pytest
 from haptic_dob.cli.identify import main
 from haptic_dob.core.kalman_velocity import process_noise, transition
 from haptic_dob.runtime.params import load_node_params
+from support.cli import exit_code
 from support.joint_bags import write_joint_states
 
 PSD = 800.0  # rad^2/s^5
@@ -93,11 +94,7 @@ def test_one_count_serves_every_joint_and_joints_may_be_chosen(
 def test_bad_options_and_a_still_record_are_refused_in_one_line(
     bag: Path, capsys: pytest.CaptureFixture[str], args: list[str], says: str
 ) -> None:
-    try:
-        code = main([str(bag), *args])
-    except SystemExit as exc:  # argparse's refusals
-        code = int(exc.code or 0)
-    assert code == 2
+    assert exit_code(main, [str(bag), *args]) == 2
     err = capsys.readouterr().err.strip()
     assert "Traceback" not in err
     # one line says what is wrong (argparse's refusals print the usage before it)
