@@ -154,12 +154,10 @@ class StateSettings:
             description="each joint's white-jerk density (units^2/s^5); 0 = the adaptive window",
             bounds=(0.0, 1e12),
             details=(
-                "One for all joints or one each. Set (> 0, with encoder_resolution) for a "
-                "differenced velocity by a steady-state Kalman filter per joint in place of the "
-                "window: constant acceleration driven by white jerk of this "
-                "density, the counts' rounding as its noise. Less lag than the window at the "
-                "same noise. Identify it from a session with the hand on the device: "
-                "haptic-identify BAG --velocity-noise (docs/devices.md)."
+                "One for all or one each; needs encoder_resolution. A steady-state Kalman filter "
+                "per joint (constant acceleration, white jerk, the counts' rounding as noise) in "
+                "place of the window: less lag at the same noise. Identify it from a session with "
+                "the hand on the device: haptic-identify BAG --velocity-noise (docs/devices.md)."
             ),
         ),
     )
