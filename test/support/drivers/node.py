@@ -6,7 +6,8 @@ writes ``truth.json`` (the plant's hidden parameters, counts, its last command) 
 ``kind`` (``fd``, ``touch``, ``arm``), ``rate_hz``, ``seed``, ``out``, ``hand``,
 ``hand_direction``, ``button`` and ``inkwell`` (touch), ``table_z`` (arm), ``rt_priority``
 (``realtime``); test controls in its namespace: ``test/pause`` (``Float64``: no state for that
-many seconds) and ``test/button`` (``Bool``).
+many seconds) and ``test/button`` (``Bool``). A Touch's stylus rests until it is taken: in the
+inkwell, until the first force; with a hand, until the white button is held (``hand_start_ns``).
 
 Tick k's instant is the first tick's plus k periods, and its state is stamped with it (when its
 positions are true, as a real driver's stamp is). ``DriverNode._tick`` says what a tick does.
@@ -81,7 +82,10 @@ class DriverNode(LoopNode):
             )
         raw_subscription(self, "std_msgs/msg/Float64", f"{ns}/test/pause", self._on_pause, LATCHED)
         self._button = bool(cfg.get("button", False))
-        self._resting = self.kind == "touch" and bool(cfg.get("inkwell", False))
+        self._hand_on = hand.get("behaviour", "none") != "none"
+        #: touch: the stylus at rest (the plant does not step) until it is taken (``_taken``)
+        self._resting = self.kind == "touch" and (bool(cfg.get("inkwell")) or self._hand_on)
+        self.hand_start_ns = -1  # the instant the plant first stepped from (-1: not yet)
         self._written = tuple(0.0 for _ in range(self.plant.dof))  # effort in force (plant joints)
         self._force = np.zeros(3)  # touch: the Cartesian force in force (base frame)
         self.deadline = time.monotonic() + 0.2
@@ -172,9 +176,11 @@ class DriverNode(LoopNode):
             self._marked = self._stamp
         if self.kind == "touch" and self._k >= 0:
             effort = self._effort()
-            self._resting = self._resting and not any(self._force)
+            self._resting = self._resting and not self._taken()
             if not self._resting:
                 self.plant.apply(effort)
+                if self.hand_start_ns < 0:
+                    self.hand_start_ns = stamp - self.period_ns
         self._k += 1
         s = self.plant.sample()
         if self.kind == "touch":
@@ -210,6 +216,13 @@ class DriverNode(LoopNode):
             by_name[GRIPPER] = (0.04, 0.0, 0.0)
             q, qd, e = zip(*(by_name[n] for n in self.names), strict=True)
             self.io.publish(stamp, self.names, q, qd, e)
+
+    def _taken(self) -> bool:
+        """Touch: the stylus leaves its rest: with a hand, once the white button is held (the
+        driver's own button state); in the inkwell, at the first force."""
+        if self._hand_on:
+            return bool(self.io.buttons[self.io.WHITE])
+        return any(self._force)
 
     def _effort(self) -> tuple[float, ...]:
         """The plant's joint effort over the coming period, the driver's way."""
@@ -269,6 +282,7 @@ class DriverNode(LoopNode):
             "scheduling": self.cfg.get("scheduling", "default scheduling"),
             "plant": self.plant.truth(),
             "counts": counts,
+            "hand_start_ns": self.hand_start_ns,
             "last_command": list(self.last_command),
             "names": list(self.names),
         }

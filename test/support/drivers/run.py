@@ -238,6 +238,13 @@ class Truth:
         sent = self.stamps[self.published & (self.stamps >= got[0]) & (self.stamps <= got[-1])]
         return float(np.isin(sent, got).mean())
 
+    @property
+    def hand_start_ns(self) -> int:
+        """The instant (ns) a Touch's plant first stepped from (its hand's time zero: the
+        press of the white button, with a hand); -1 when it never left its rest or is no
+        Touch."""
+        return int(self.info.get("hand_start_ns", -1))
+
     def tick_of(self, stamp_ns: int) -> int:
         """The index of the tick whose state carried ``stamp_ns``."""
         return int(np.searchsorted(self.stamps, stamp_ns))
