@@ -12,13 +12,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from haptic_dob.bridge.driver_settings import (
-    PROFILES,
-    RELIABILITY,
-    CommandSettings,
-    FrameSettings,
-    StateSettings,
-)
+from haptic_dob.bridge.driver_settings import PROFILES, CommandSettings, FrameSettings
+from haptic_dob.bridge.state_settings import RELIABILITY, StateSettings
 from haptic_dob.runtime.params import ParamSpec, param, specs_of
 
 DEADMAN_TYPES = ("none", "bool", "joy")

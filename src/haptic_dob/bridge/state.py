@@ -17,8 +17,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from haptic_dob.bridge.driver_settings import FrameSettings, StateSettings
+from haptic_dob.bridge.driver_settings import FrameSettings
 from haptic_dob.bridge.settings import per_element
+from haptic_dob.bridge.state_settings import StateSettings
 from haptic_dob.bridge.velocity import KalmanVelocity, Velocity, VelocityFilter, WindowVelocity
 from haptic_dob.core.joint_states import JointMap, pick
 from haptic_dob.core.models.base import DeviceModel

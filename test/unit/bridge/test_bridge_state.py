@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from haptic_dob.bridge.driver_settings import FrameSettings, StateSettings
+from haptic_dob.bridge.driver_settings import FrameSettings
 from haptic_dob.bridge.state import StateReader
+from haptic_dob.bridge.state_settings import StateSettings
 from haptic_dob.bridge.velocity import VelocityFilter
 
 MODEL = ("phi1", "phi2", "phi3")

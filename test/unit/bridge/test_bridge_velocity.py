@@ -11,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from haptic_dob.bridge.driver_settings import FrameSettings, StateSettings
+from haptic_dob.bridge.driver_settings import FrameSettings
 from haptic_dob.bridge.state import StateReader
+from haptic_dob.bridge.state_settings import StateSettings
 from haptic_dob.bridge.velocity import KalmanVelocity, Velocity, VelocityFilter, WindowVelocity
 from haptic_dob.core.kalman_velocity import KalmanState, steady_gain
 from haptic_dob.identification.velocity_noise import identify_jerk_psd
