@@ -19,14 +19,14 @@ from haptic_msgs_py.stamps import command_label
 
 Encoder = Callable[[int, Sequence[float]], bytes]
 
-#: the ROS type of each command kind (``bridge.settings.COMMAND_TYPES``)
+#: the ROS type of each command kind (``bridge.driver_settings.COMMAND_TYPES``)
 COMMAND_TYPENAMES = {
     "float64_multi_array": "std_msgs/msg/Float64MultiArray",
     "wrench_stamped": "geometry_msgs/msg/WrenchStamped",
     "wrench": "geometry_msgs/msg/Wrench",
     "vector3": "geometry_msgs/msg/Vector3",
 }
-#: the ROS type of each state kind (``bridge.settings.STATE_TYPES``)
+#: the ROS type of each state kind (``bridge.state_settings.STATE_TYPES``)
 STATE_TYPENAMES = {
     "joint_states": "sensor_msgs/msg/JointState",
     "pose": "geometry_msgs/msg/PoseStamped",

@@ -24,7 +24,9 @@ from haptic_dob.core.kalman_velocity import innovations, steady_gain
 from haptic_dob.identification.filters import IdentificationError
 
 MIN_COUNTS = 10  # a joint is fitted when its positions span at least this many counts
-SETTLE_S = 0.2  # the filter's start left out of the likelihood (s)
+SETTLE_S = 0.2  # the filter's start left out of the likelihood, in every run (s)
+MIN_RUN_S = 0.3  # a run's length after SETTLE_S for it to count (s): lost samples end runs
+MIN_TOTAL_S = 1.0  # the runs' lengths after SETTLE_S, summed, that a fit needs (s)
 LOG10_BOUNDS = (-6.0, 12.0)  # the search's bounds on log10(psd)
 
 
@@ -75,19 +77,23 @@ def identify_jerk_psd(
     counts: Sequence[float],
 ) -> JerkFit:
     """Fit one density to the joints (columns of ``positions``) whose positions span
-    ``MIN_COUNTS`` counts or more, over the record's evenly sampled runs of 1 s or more.
-    ``IdentificationError`` when no joint moved, no run is long enough, a joint steps by less
-    than half its count, or the optimum lies on the search's bounds."""
+    ``MIN_COUNTS`` counts or more, over the record's evenly sampled runs (``segments``) long
+    enough (``MIN_RUN_S`` after ``SETTLE_S``), ``MIN_TOTAL_S`` in all. ``IdentificationError``
+    when no joint moved, the runs are too short, a joint steps by less than half its count, or
+    the optimum lies on the search's bounds."""
     q = np.asarray(positions, dtype=np.float64)
     if q.ndim != 2 or q.shape != (len(stamps_ns), len(names)) or len(counts) != len(names):
         raise IdentificationError(
             "positions need one row per stamp, and one column and one count per joint"
         )
     period, runs = segments(stamps_ns)
-    runs = [r for r in runs if (r.stop - r.start) * period >= SETTLE_S + 1.0]
-    if not runs:
+    runs = [r for r in runs if (r.stop - r.start) * period >= SETTLE_S + MIN_RUN_S]
+    usable_s = sum((r.stop - r.start) * period - SETTLE_S for r in runs)
+    if usable_s < MIN_TOTAL_S:
         raise IdentificationError(
-            f"no evenly sampled run of {SETTLE_S + 1.0:g} s or more (period {1e3 * period:.3g} ms)"
+            f"the record's evenly sampled runs of {SETTLE_S + MIN_RUN_S:g} s or more hold "
+            f"{usable_s:.2g} s after their first {SETTLE_S:g} s, the fit needs {MIN_TOTAL_S:g} s "
+            f"(period {1e3 * period:.3g} ms): record longer, or with fewer states lost"
         )
     spans = tuple(float(np.ptp(q[:, j])) / c for j, c in enumerate(counts))
     moved = [j for j, s in enumerate(spans) if s >= MIN_COUNTS]

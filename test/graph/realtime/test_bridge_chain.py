@@ -4,8 +4,8 @@ What docs/devices.md tells a lab to type, against a test driver whose plant's tr
 knows: the excitation session (``haptic-launch <config> --params excite/<device> --record``) ->
 ``haptic-identify`` on that bag -> a recorded DOB session with that model, the simulated hand
 pushing into the wall. The figure is the RMS of the estimate's 3-D error (matched by stamp with
-the plant's hand force) over the true force's span, in contact from 2 s to 8 s of the hand's
-time, the window of the batch chain (``test/unit/bridge/test_bridge_chain.py``).
+the plant's hand force) over the true force's span, in contact from 2 s on (a Touch's: to 8 s
+of its hand's time, the batch chain's window, ``test/unit/bridge/test_bridge_chain.py``).
 
 - forcedimension_ros2-like (1 kHz, ``--axes``): mass 5 %, viscous friction 10 %, estimate 5 %.
 - Touch-like (500 Hz, best-effort position-only states, the white button; ``--inertial``): the
@@ -45,12 +45,13 @@ pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
 CONFIG = ROOT / "config"
 SLIDE_LOOP = ["device_node", "environment_node", "observer_node", "controller_node"]
-DOB_S = 8.0  # the hand's 1 s ramp, 2 s settling, 5 s in contact
+DOB_S = 8.0  # the DOB session: the hand's 1 s ramp, then SETTLE_S, then the figure's window
 SETTLE_S = 2.0
-#: a Touch's hand moves from the test's press of the white button on, after the loop is up: the
-#: session runs this much longer, so that the figure covers the hand's time from SETTLE_S to
-#: DOB_S, as the batch chain's does (a press takes a fraction of a second; a retry 2.5 s)
-PRESS_S = 3.0
+#: a Touch's hand moves from the test's press of the white button on, once the loop is up and
+#: the press can be heard (the test presses again, 2.5 s on, where the bridge did not see it):
+#: the session runs this much longer, so that the figure covers the hand's time from SETTLE_S
+#: to DOB_S, as the batch chain's does; a session that did not is said (the premise)
+PRESS_S = 4.0
 WRENCH = "geometry_msgs/msg/WrenchStamped"
 #: the Touch chain's premise: its viscous friction, 1-2 mN m s/rad, is the figure the loop's
 #: timing moves most. On a machine 2-3 times slower than usual (2026-11-28: stalls to 20 ms,
@@ -152,11 +153,11 @@ def identify(bag: Path, tmp: Path, args: list[str], figures: Figures) -> tuple[P
     return model, json.loads(cli.stdout)
 
 
-def estimate_error(truth: Truth, bag: Path, config: str) -> float:
+def estimate_error(truth: Truth, bag: Path, config: str) -> tuple[float, float]:
     """The estimate's RMS 3-D error over the true hand force's span along the wall's normal, in
-    contact (the plant's tip inside the config's wall) from ``SETTLE_S`` to ``DOB_S`` of the
-    hand's time (a Touch's from its press, ``Truth.hand_start_ns``; else from the first
-    estimate), matched by stamp."""
+    contact (the plant's tip inside the config's wall) from ``SETTLE_S`` on, matched by stamp;
+    with a Touch's hand (``Truth.hand_start_ns``) to ``DOB_S`` of its time, else from the first
+    estimate to the end. Also the share of that window's states the session covered."""
     with open_bag(bag) as reader:
         conns = [c for c in reader.connections if c.topic == "/haptic/wrench_estimate"]
         datas = [data for _, _, data in reader.messages(connections=conns)]
@@ -169,16 +170,15 @@ def estimate_error(truth: Truth, bag: Path, config: str) -> float:
     assert len(idx) >= 0.9 * DOB_S * float(truth.info["rate_hz"]) * 0.5
     wall = build(VirtualWall, node_view(load_node_params(CONFIG / config), "environment_node"))
     normal = np.asarray(wall.normal)
-    start = truth.hand_start_ns if truth.hand_start_ns >= 0 else truth.stamps[idx[0]]
-    t = (truth.stamps[idx] - start) * 1e-9
-    window = (t >= SETTLE_S) & (t < DOB_S)
-    rate = float(truth.info["rate_hz"])
-    assert window.sum() >= 0.9 * (DOB_S - SETTLE_S) * rate, "the session ended before DOB_S"
+    hand_time = truth.hand_start_ns >= 0
+    t = (truth.stamps[idx] - (truth.hand_start_ns if hand_time else truth.stamps[idx[0]])) * 1e-9
+    window = (t >= SETTLE_S) & (t < (DOB_S if hand_time else np.inf))
+    covered = float(window.sum() / ((DOB_S - SETTLE_S) * float(truth.info["rate_hz"])))
     contact = ((truth.tip[idx] - np.asarray(wall.position)) @ normal > 0.0) & window
     assert contact.sum() >= 0.8 * window.sum(), "the hand did not hold the wall"
     hand = truth.hand[idx][contact]
     err = np.linalg.norm(est[contact] - hand, axis=1)
-    return float(np.sqrt(np.mean(err**2)) / np.ptp(hand @ normal))
+    return float(np.sqrt(np.mean(err**2)) / np.ptp(hand @ normal)), covered
 
 
 def test_forcedimension_chain_through_the_bridge(tmp_path: Path) -> None:
@@ -206,7 +206,7 @@ def test_forcedimension_chain_through_the_bridge(tmp_path: Path) -> None:
     hops.append(hop_floor_us())
     require_path_latency("fd", max(hops))
     figures.premise(kept_real_time(truth, counts, 1000.0))
-    error = estimate_error(truth, bag, config)
+    error, _ = estimate_error(truth, bag, config)
     figures.check(error <= 0.05, f"estimate {100 * error:.1f} % of the span")
     figures.end()
 
@@ -259,6 +259,11 @@ def test_touch_chain_through_the_bridge(tmp_path: Path) -> None:
     hops.append(hop_floor_us())
     require_path_latency("touch", max(hops), 500.0)
     figures.premise(kept_real_time(truth, counts, 500.0, TOUCH_ON_TIME))
-    error = estimate_error(truth, bag, config)
+    error, covered = estimate_error(truth, bag, config)
+    if covered < 0.9:
+        figures.premise(
+            f"the session covered {100 * covered:.0f} % of the hand's time from {SETTLE_S:g} to "
+            f"{DOB_S:g} s (the press was heard late)"
+        )
     figures.check(error <= 0.05, f"estimate {100 * error:.2f} % of the span")
     figures.end()

@@ -7,7 +7,8 @@ writes ``truth.json`` (the plant's hidden parameters, counts, its last command) 
 ``hand_direction``, ``button`` and ``inkwell`` (touch), ``table_z`` (arm), ``rt_priority``
 (``realtime``); test controls in its namespace: ``test/pause`` (``Float64``: no state for that
 many seconds) and ``test/button`` (``Bool``). A Touch's stylus rests until it is taken: in the
-inkwell, until the first force; with a hand, until the white button is held (``hand_start_ns``).
+inkwell, until the first force; with a hand, once a press of the white button could be heard
+(``_taken``, ``hand_start_ns``).
 
 Tick k's instant is the first tick's plus k periods, and its state is stamped with it (when its
 positions are true, as a real driver's stamp is). ``DriverNode._tick`` says what a tick does.
@@ -82,7 +83,7 @@ class DriverNode(LoopNode):
             )
         raw_subscription(self, "std_msgs/msg/Float64", f"{ns}/test/pause", self._on_pause, LATCHED)
         self._button = bool(cfg.get("button", False))
-        self._hand_on = hand.get("behaviour", "none") != "none"
+        self._hand_on = self.kind == "touch" and self.plant.device.hand.behaviour != "none"
         #: touch: the stylus at rest (the plant does not step) until it is taken (``_taken``)
         self._resting = self.kind == "touch" and (bool(cfg.get("inkwell")) or self._hand_on)
         self.hand_start_ns = -1  # the instant the plant first stepped from (-1: not yet)
@@ -218,10 +219,12 @@ class DriverNode(LoopNode):
             self.io.publish(stamp, self.names, q, qd, e)
 
     def _taken(self) -> bool:
-        """Touch: the stylus leaves its rest: with a hand, once the white button is held (the
-        driver's own button state); in the inkwell, at the first force."""
-        if self._hand_on:
-            return bool(self.io.buttons[self.io.WHITE])
+        """Touch: the stylus leaves its rest: with a hand, once the white button is held and its
+        press went out to a matched reader (the bridge's dead-man, which a press it missed would
+        leave released: the test presses again); in the inkwell, at the first force."""
+        if self._hand_on:  # (``button`` held from the start: no press to hear)
+            held_from_start = bool(self.cfg.get("button", False))
+            return bool(self.io.buttons[self.io.WHITE]) and (self.io.press_heard or held_from_start)
         return any(self._force)
 
     def _effort(self) -> tuple[float, ...]:

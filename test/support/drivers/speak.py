@@ -172,6 +172,9 @@ class Touch:
         self._received = received
         self.force = (0.0, 0.0, 0.0)  # the newest force taken (driver axes)
         self.buttons = [0, 0]
+        #: the white button's newest press went out to a matched reader (the bridge could hear
+        #: it: the Joy is volatile, a press before the match is lost)
+        self.press_heard = False
         self.nonfinite_dropped = 0
 
     def receive(self, before_ns: int | None) -> None:
@@ -189,6 +192,7 @@ class Touch:
         new = 1 if held else 0
         if new != self.buttons[self.WHITE]:
             self.buttons[self.WHITE] = new
+            self.press_heard = bool(new) and self._buttons_pub.get_subscription_count() > 0
             sec, nsec = divmod(stamp_ns, 1_000_000_000)
             msg = wire.TYPESTORE.types["sensor_msgs/msg/Joy"](
                 header=wire.Header(stamp=wire.Time(sec=sec, nanosec=nsec), frame_id=""),
