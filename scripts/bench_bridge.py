@@ -24,7 +24,6 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -33,6 +32,7 @@ sys.path.insert(0, str(ROOT / "test"))  # the test drivers live with the tests
 from bench_graph import GRAPH_ARGS  # noqa: E402
 from haptic_dob.runtime.ros.dds_hop import hop_us  # noqa: E402
 from support.drivers.run import SLIDE_HAND, Controls, Truth, start  # noqa: E402
+from support.waits import wait_until  # noqa: E402
 
 RUN_S = 10.0
 #: ``taskset -c`` CPU list of the driver and the loop (``--cpus``); empty: the process's CPUs
@@ -105,25 +105,31 @@ def one_run(profile: str) -> dict[str, float]:
         argv += [*extra, "--set", f"{bridge_name}:duration_s={RUN_S}"]
         argv += ["--set", f"{bridge_name}:stats_file={d / 'bridge.json'}"]
         argv += [a for a in GRAPH_ARGS if a != "--pin"]  # one process: nothing to pin
-        graph = subprocess.Popen(
-            argv,
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            start_new_session=True,  # its own group: a run that hangs is stopped whole
-        )
+        log = d / "launch.log"
+        with log.open("wb") as sink:
+            graph = subprocess.Popen(
+                argv,
+                env=env,
+                stdout=sink,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,  # its own group: a run that hangs is stopped whole
+            )
+
+        def output() -> str:
+            return log.read_text(errors="replace")
+
         try:
-            if controls is not None:
-                time.sleep(3.0)  # the bridge is up: the user holds the stylus's button
-                controls.press(True)
-            out, _ = graph.communicate(timeout=RUN_S + 120)
+            if controls is not None:  # the bridge is up: the user holds the stylus's button
+                wait_until(lambda: "the loop is up" in output(), 120.0)
+                controls.hold(output)  # the driver's hand moves from the press the bridge heard
+            graph.wait(timeout=RUN_S + 120)
         finally:
             stop_group(graph)
             if controls is not None:
                 controls.close()
             drv.stop()
         if graph.returncode != 0:
-            raise RuntimeError(f"haptic-launch failed: {out.decode()[-1500:]}")
+            raise RuntimeError(f"haptic-launch failed: {output()[-1500:]}")
         truth = Truth.read(d / "driver")
         bridge = json.loads((d / "bridge.json").read_text())
     hop_after = hop_us(2000, domain_id=domain)
