@@ -6,9 +6,8 @@ writes ``truth.json`` (the plant's hidden parameters, counts, its last command) 
 ``kind`` (``fd``, ``touch``, ``arm``), ``rate_hz``, ``seed``, ``out``, ``hand``,
 ``hand_direction``, ``button`` and ``inkwell`` (touch), ``table_z`` (arm), ``rt_priority``
 (``realtime``); test controls in its namespace: ``test/pause`` (``Float64``: no state for that
-many seconds) and ``test/button`` (``Bool``). A Touch's stylus rests until it is taken: in the
-inkwell, until the first force; with a hand, once a press of the white button could be heard
-(``_taken``, ``hand_start_ns``).
+many seconds) and ``test/button`` (``Bool``). A Touch's stylus rests until it is taken
+(``_taken``: the first force in the inkwell; a heard press with a hand, ``hand_start_ns``).
 
 Tick k's instant is the first tick's plus k periods, and its state is stamped with it (when its
 positions are true, as a real driver's stamp is). ``DriverNode._tick`` says what a tick does.
