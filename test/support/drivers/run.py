@@ -233,6 +233,7 @@ class Truth:
         """Of the states published from the first one a command answered to the last, the share
         some command answered (a gate that closed in between, or states lost, lower it)."""
         got = np.unique(self.answered[self.answered >= 0])
+        got = got[np.isin(got, self.stamps)]  # a bridge's zero before any state answers none
         if len(got) == 0:
             return 0.0
         sent = self.stamps[self.published & (self.stamps >= got[0]) & (self.stamps <= got[-1])]

@@ -175,6 +175,7 @@ class Touch:
         #: the white button's newest press went out to a matched reader (the bridge could hear
         #: it: the Joy is volatile, a press before the match is lost)
         self.press_heard = False
+        self._joy(0)  # rosbags builds a type's serializer at its first use: 12 ms, not mid-run
         self.nonfinite_dropped = 0
 
     def receive(self, before_ns: int | None) -> None:
@@ -193,13 +194,17 @@ class Touch:
         if new != self.buttons[self.WHITE]:
             self.buttons[self.WHITE] = new
             self.press_heard = bool(new) and self._buttons_pub.get_subscription_count() > 0
-            sec, nsec = divmod(stamp_ns, 1_000_000_000)
-            msg = wire.TYPESTORE.types["sensor_msgs/msg/Joy"](
-                header=wire.Header(stamp=wire.Time(sec=sec, nanosec=nsec), frame_id=""),
-                axes=np.zeros(0, dtype=np.float32),
-                buttons=np.array(self.buttons, dtype=np.int32),
-            )
-            self._buttons_pub.publish(wire.encode(msg))
+            self._buttons_pub.publish(self._joy(stamp_ns))
+
+    def _joy(self, stamp_ns: int) -> bytes:
+        """The buttons as a serialized ``sensor_msgs/Joy`` stamped ``stamp_ns``."""
+        sec, nsec = divmod(stamp_ns, 1_000_000_000)
+        msg = wire.TYPESTORE.types["sensor_msgs/msg/Joy"](
+            header=wire.Header(stamp=wire.Time(sec=sec, nanosec=nsec), frame_id=""),
+            axes=np.zeros(0, dtype=np.float32),
+            buttons=np.array(self.buttons, dtype=np.int32),
+        )
+        return wire.encode(msg)
 
     @property
     def gated_force(self) -> tuple[float, float, float]:
