@@ -79,16 +79,18 @@ def test_driver_state_stops_zero_and_the_stale_state_is_not_rendered(tmp_path) -
     """The driver's state stops (its publisher stalls while its controller still listens): the
     bridge sends zero after ``state.timeout_s``, refuses the loop's late commands for the last
     state, and resumes when the state comes back."""
-    run = BridgeRun(tmp_path, lambda k: PUSH, **{"state.timeout_s": 0.01})
+    # state.timeout_s as BridgeRun sets it (50 ms): 10 ms trips again after the state is back,
+    # beside a CPU hog, and each trip drops the answers to the states before it
+    run = BridgeRun(tmp_path, lambda k: PUSH)
     controls = Controls(run.env, "/fd")
     try:
         started(run, 300)
         controls.pause(0.5)
         seen = [run.loop.count()]
 
-        def quiet() -> bool:  # no new sample since the last look (20 ms): the pause is on
+        def quiet() -> bool:  # no new sample for five looks (100 ms): the pause is on
             seen.append(run.loop.count())
-            return seen[-1] == seen[-2]
+            return len(seen) > 5 and len(set(seen[-6:])) == 1
 
         assert wait_until(quiet, WAIT_S, poll_s=0.02)
         silent_from = run.loop.newest_stamp()
@@ -96,12 +98,23 @@ def test_driver_state_stops_zero_and_the_stale_state_is_not_rendered(tmp_path) -
         while time.monotonic() < t_stale + 0.3:  # the loop insists on the stale sample
             run.loop.send(silent_from, PUSH)
             time.sleep(0.01)
-        assert run.loop.wait_samples(300, WAIT_S)  # the state is back: the loop resumes
+        # the state is back (a newer sample): the loop resumes
+        assert wait_until(lambda: run.loop.newest_stamp() > silent_from, WAIT_S)
+        assert run.loop.wait_samples(300, WAIT_S)
     finally:
         controls.close()
         truth = run.finish()
     paused = ~truth.published
     assert paused.sum() >= 100, "the pause did not happen"
+    # the premise: the quiet the test saw was the pause (not a stall of this process beside a
+    # CPU hog), so that the loop insisted on the state before it for the whole 0.3 s
+    after = truth.stamps[truth.published & (truth.stamps > silent_from)]
+    gap_s = (after[0] - silent_from) * 1e-9 if len(after) else math.inf
+    if gap_s < 0.4:
+        pytest.skip(
+            f"the loop's quiet was a stall of {gap_s * 1e3:.0f} ms before the pause on this "
+            f"machine now (the test presumes the pause, 500 ms): {run.counts()}"
+        )
     last = np.flatnonzero(paused)[-1]
     cmd = truth.commands
     # the loop's 30 insisting pushes for the stale sample: none passes (its one answer may)
@@ -153,7 +166,6 @@ def test_deadman_released_zero_at_once(tmp_path) -> None:
     # machine), then zero for good
     pushes = np.flatnonzero(nonzero(after[:, 2:]))
     settled = int(pushes[-1]) + 1 if len(pushes) else 0
-    assert len(after) - settled >= 150, "too few commands after the release to tell"
     assert truth.info["last_command"] == [0.0, 0.0, 0.0]
     counts = run.counts()
     assert counts["deadman_releases"] == 1
@@ -162,6 +174,8 @@ def test_deadman_released_zero_at_once(tmp_path) -> None:
             f"pushes reached the driver for {settled} commands after the release on this "
             f"machine now (the bridge behind its queues; the test presumes 100): {counts}"
         )
+    # the 300 samples after the release leave, behind at most 100 in flight, 150 zeros
+    assert len(after) - settled >= 150, "too few commands after the release to tell"
 
 
 def test_nan_from_the_law_is_never_sent(tmp_path) -> None:

@@ -36,6 +36,9 @@ from haptic_msgs_py.stamps import period_ns
 from haptic_msgs_py.values import EffortCommand
 
 Vec3 = tuple[float, float, float]
+#: states whose arrival the bridge keeps for its latency: a command answering an older one is
+#: counted late but not timed
+ARRIVALS_KEPT = 32
 
 
 class LoopSample(NamedTuple):
@@ -112,8 +115,10 @@ class BridgeLoop:
         self.newest_ns = -1  # stamp of the newest state handed on
         self.answered_ns = -1  # stamp of the newest sample commanded
         self._newest_q: tuple[float, ...] = self._zero_model
-        self._newest_t = 0.0
-        self.latency = LatencyHistogram()  # s, state arrival -> its command sent
+        #: (stamp ns, monotonic arrival s) of the newest states handed on: a late command's
+        #: latency counts from its own state's arrival
+        self._arrivals: deque[tuple[int, float]] = deque(maxlen=ARRIVALS_KEPT)
+        self.latency = LatencyHistogram()  # s, state arrival -> its command sent (every one)
         self.states = self.on_time = self.late = 0
         self.refused = self.dropped = self.gated = self.zeros = 0
         self.state_trips = self.deadman_releases = self.repeated = 0
@@ -148,7 +153,8 @@ class BridgeLoop:
         if self.answered_ns != self.newest_ns and self.on_time + self.late:
             self.late += 1  # the previous state got no command at all
         self.k += 1
-        self.newest_ns, self._newest_q, self._newest_t = s.stamp_ns, s.q, now
+        self.newest_ns, self._newest_q = s.stamp_ns, s.q
+        self._arrivals.append((s.stamp_ns, now))
         self._newest_instant = instant
         zero = None
         if self.watchdog.due(self.k, self.command_timeout_s):
@@ -197,7 +203,9 @@ class BridgeLoop:
                 self.on_time += 1
             else:
                 self.late += 1
-            self.latency.add(now - self._newest_t)
+        arrived = next((t for k, t in reversed(self._arrivals) if k == stamp), None)
+        if arrived is not None:  # an unlabelled command answers the newest: found too
+            self.latency.add(now - arrived)
         if not self.deadman_held:
             self.gated += 1
             return None

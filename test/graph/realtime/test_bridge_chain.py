@@ -11,8 +11,8 @@ of its hand's time, the batch chain's window, ``test/unit/bridge/test_bridge_cha
 - Touch-like (500 Hz, best-effort position-only states, the white button; ``--inertial``): the
   payload's gravity torque within 5 %, Coulomb friction within 20 %, viscous within 10 %; an OL
   session -> ``--velocity-noise`` (the Kalman velocity filter); the estimate within 5 %.
-
-Each skips where this machine cannot carry the loop and its recorder in real time now."""
+The loop runs under SCHED_FIFO and a PM QoS request where this machine allows them, as a lab
+runs it. Each skips where this machine cannot carry the loop and its recorder in real time now."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ from haptic_dob.core.environment import VirtualWall
 from haptic_dob.core.models import UrdfModel
 from haptic_dob.runtime.params import build, load_node_params, node_view
 from support.capacity import hop_floor_us, require_path_latency, require_realtime
-from support.drivers import plants
+from support.drivers import plants, scheduling
 from support.drivers.run import (
     CHAIN_ON_TIME,
     DRIVER_SHARE,
@@ -86,11 +86,12 @@ def session(
     tmp: Path, name: str, driver: dict[str, Any], config: str, args: list[str]
 ) -> tuple[Truth, dict[str, Any], Path]:
     """The driver and ``haptic-launch config --namespace /haptic ARGS --record`` until the
-    bridge's ``duration_s``; the driver's truth, the bridge's counts and the bag."""
+    bridge's ``duration_s``, the loop in real time where this machine allows it
+    (``scheduling``); the driver's truth, the bridge's counts and the bag."""
     bag = tmp / f"{name}_bag"
     # a Python test driver beside a CPU hog stalls for more than 10 ms now and then (BridgeRun)
     sets = ["bridge_node:state.timeout_s=0.05"]
-    extra = [*args, "--record", str(bag)]
+    extra = [*args, *scheduling.launch_args(), "--record", str(bag)]
     truth, counts = bridge_session(CONFIG / config, driver, tmp / name, sets, extra)
     return truth, counts, bag
 
@@ -115,7 +116,8 @@ def kept_real_time(
         return ""
     return (
         f"{100 * on_time:.1f} % of the commands reached the test driver before its next state "
-        f"at {rate_hz:g} Hz on this machine now (the chain presumes {100 * presumed:g} %)"
+        f"at {rate_hz:g} Hz on this machine now, {scheduling.described()} (the chain "
+        f"presumes {100 * presumed:g} %)"
     )
 
 

@@ -148,7 +148,9 @@ class Controls:
         raise AssertionError(f"the bridge never saw the button held:\n{output()[-2000:]}")
 
     def pause(self, seconds: float) -> None:
-        """The driver publishes no state for ``seconds``."""
+        """The driver publishes no state for ``seconds`` from when it takes the message (sent
+        once the driver subscribes: a message kept for a later match starts the pause late)."""
+        assert wait_until(lambda: self._pause.get_subscription_count() > 0, 60.0)
         self._pause.publish(self._float(data=seconds))
 
     def close(self) -> None:

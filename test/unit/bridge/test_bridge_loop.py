@@ -276,3 +276,18 @@ def test_the_stats_file_writes_nothing_measured_as_null(tmp_path: Path) -> None:
     write_stats(str(path), bridge().counts())
     written = json.loads(path.read_text())
     assert written["on_time_pct"] is None and written["states"] == 0
+
+
+def test_a_late_commands_latency_counts_from_its_own_states_arrival() -> None:
+    """The latency is every taken command's, from the arrival of the state it answers: one
+    answering a state no longer the newest is timed too, from that state."""
+    b = bridge()
+    b.start()
+    b.on_state(state(1), 0.0)
+    b.on_command(cmd(1), 0.0002)  # 0.2 ms, on time
+    b.on_state(state(2), 0.001)
+    b.on_state(state(3), 0.002)
+    assert b.on_command(cmd(2), 0.0045) is not None  # 3.5 ms after state 2 arrived
+    assert b.latency.n == 2
+    assert b.counts()["latency_p99_ms"] == pytest.approx(3.501, abs=2e-3)
+    assert b.counts()["latency_p50_ms"] == pytest.approx(0.201, abs=2e-3)
