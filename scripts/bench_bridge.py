@@ -16,6 +16,7 @@ LIST``, on the CPUs the machine stalls least (``timer-floor``; docs/running.md).
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import random
@@ -167,4 +168,12 @@ def bench_bridge(repeat: int) -> str:
 
 
 if __name__ == "__main__":
-    print(bench_bridge(int(sys.argv[1]) if len(sys.argv) > 1 else 1))
+    parser = argparse.ArgumentParser(
+        description="The device bridge's driver-state -> command latency against one raw hop.",
+        epilog="scripts/benchmarks.py bridge runs it with --rt-priority, --cpu-latency, --cpus.",
+    )
+    parser.add_argument("repeat", nargs="?", type=int, default=1, help="runs per profile (>= 1)")
+    args = parser.parse_args()
+    if args.repeat < 1:
+        parser.error(f"repeat {args.repeat}: must be 1 or more")
+    print(bench_bridge(args.repeat))
