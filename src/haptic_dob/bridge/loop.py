@@ -37,7 +37,7 @@ from haptic_msgs_py.values import EffortCommand
 
 Vec3 = tuple[float, float, float]
 #: states whose arrival the bridge keeps for its latency: a command answering an older one is
-#: counted late but not timed
+#: timed from the oldest kept (a lower bound, as the histogram's top bin is)
 ARRIVALS_KEPT = 32
 
 
@@ -118,7 +118,7 @@ class BridgeLoop:
         #: (stamp ns, monotonic arrival s) of the newest states handed on: a late command's
         #: latency counts from its own state's arrival
         self._arrivals: deque[tuple[int, float]] = deque(maxlen=ARRIVALS_KEPT)
-        self.latency = LatencyHistogram()  # s, state arrival -> its command sent (every one)
+        self.latency = LatencyHistogram()  # s, state arrival -> a command for it taken
         self.states = self.on_time = self.late = 0
         self.refused = self.dropped = self.gated = self.zeros = 0
         self.state_trips = self.deadman_releases = self.repeated = 0
@@ -204,6 +204,8 @@ class BridgeLoop:
             else:
                 self.late += 1
         arrived = next((t for k, t in reversed(self._arrivals) if k == stamp), None)
+        if arrived is None and stamp < self._arrivals[0][0]:  # older than kept: at least this
+            arrived = self._arrivals[0][1]
         if arrived is not None:  # an unlabelled command answers the newest: found too
             self.latency.add(now - arrived)
         if not self.deadman_held:

@@ -27,6 +27,9 @@ MIN_COUNTS = 10  # a joint is fitted when its positions span at least this many 
 SETTLE_S = 0.2  # the filter's start left out of the likelihood, in every run (s)
 MIN_RUN_S = 0.3  # a run's length after SETTLE_S for it to count (s): lost samples end runs
 MIN_TOTAL_S = 1.0  # the runs' lengths after SETTLE_S, summed, that a fit needs (s)
+#: a stretch this long (s) over which no joint steps a count: the device parked or held (an
+#: inkwell, before the user takes the stylus), left out as the arm's fits leave it out
+HELD_S = 0.5
 LOG10_BOUNDS = (-6.0, 12.0)  # the search's bounds on log10(psd)
 
 
@@ -70,6 +73,24 @@ def segments(stamps_ns: NDArray[np.int64]) -> tuple[float, list[slice]]:
     return period, [slice(a, b) for a, b in itertools.pairwise(edges)]
 
 
+def moving_runs(runs: Sequence[slice], q: NDArray[np.float64], period_s: float) -> list[slice]:
+    """``runs`` with the stretches of ``HELD_S`` or more where no column of ``q`` changed
+    taken out: a parked device's innovations are zero, and would pull the density down."""
+    still = np.zeros(len(q), dtype=bool)
+    steps = np.concatenate([[True], np.any(np.diff(q, axis=0) != 0.0, axis=1), [True]])
+    edges = np.flatnonzero(steps)  # sample i steps from i-1 (the ends count as steps)
+    for a, b in itertools.pairwise(edges):  # samples a .. b-1 hold q[a]
+        if (b - 1 - a) * period_s >= HELD_S:
+            still[a:b] = True
+    out = []
+    for r in runs:
+        keep = np.concatenate([[False], ~still[r], [False]]).astype(np.int8)
+        starts = np.flatnonzero(np.diff(keep) == 1)
+        ends = np.flatnonzero(np.diff(keep) == -1)
+        out += [slice(r.start + a, r.start + b) for a, b in zip(starts, ends, strict=True)]
+    return out
+
+
 def identify_jerk_psd(
     stamps_ns: NDArray[np.int64],
     positions: NDArray[np.float64],
@@ -77,24 +98,16 @@ def identify_jerk_psd(
     counts: Sequence[float],
 ) -> JerkFit:
     """Fit one density to the joints (columns of ``positions``) whose positions span
-    ``MIN_COUNTS`` counts or more, over the record's evenly sampled runs (``segments``) long
-    enough (``MIN_RUN_S`` after ``SETTLE_S``), ``MIN_TOTAL_S`` in all. ``IdentificationError``
-    when no joint moved, the runs are too short, a joint steps by less than half its count, or
-    the optimum lies on the search's bounds."""
+    ``MIN_COUNTS`` counts or more, over the record's evenly sampled runs (``segments``) with the
+    device moving (``moving_runs``) long enough (``MIN_RUN_S`` after ``SETTLE_S``),
+    ``MIN_TOTAL_S`` in all. ``IdentificationError`` when no joint moved, the runs are too short,
+    a joint steps by less than half its count, or the optimum lies on the search's bounds."""
     q = np.asarray(positions, dtype=np.float64)
     if q.ndim != 2 or q.shape != (len(stamps_ns), len(names)) or len(counts) != len(names):
         raise IdentificationError(
             "positions need one row per stamp, and one column and one count per joint"
         )
     period, runs = segments(stamps_ns)
-    runs = [r for r in runs if (r.stop - r.start) * period >= SETTLE_S + MIN_RUN_S]
-    usable_s = sum((r.stop - r.start) * period - SETTLE_S for r in runs)
-    if usable_s < MIN_TOTAL_S:
-        raise IdentificationError(
-            f"the record's evenly sampled runs of {SETTLE_S + MIN_RUN_S:g} s or more hold "
-            f"{usable_s:.2g} s after their first {SETTLE_S:g} s, the fit needs {MIN_TOTAL_S:g} s "
-            f"(period {1e3 * period:.3g} ms): record longer, or with fewer states lost"
-        )
     spans = tuple(float(np.ptp(q[:, j])) / c for j, c in enumerate(counts))
     moved = [j for j, s in enumerate(spans) if s >= MIN_COUNTS]
     if not moved:
@@ -111,6 +124,16 @@ def identify_jerk_psd(
                 f"{names[j]} steps by {steps.min():.3g}, under half the count given "
                 f"({counts[j]:.3g}): give the count it has, the smallest step it takes"
             )
+    runs = moving_runs(runs, q, period)
+    runs = [r for r in runs if (r.stop - r.start) * period >= SETTLE_S + MIN_RUN_S]
+    usable_s = sum((r.stop - r.start) * period - SETTLE_S for r in runs)
+    if usable_s < MIN_TOTAL_S:
+        raise IdentificationError(
+            f"the record's evenly sampled runs of {SETTLE_S + MIN_RUN_S:g} s or more with the "
+            f"device moving hold {usable_s:.2g} s after their first {SETTLE_S:g} s, the fit "
+            f"needs {MIN_TOTAL_S:g} s (period {1e3 * period:.3g} ms): record longer, with the "
+            "hand moving the device, or with fewer states lost"
+        )
     records = [q[r, j] for j in moved for r in runs]
     cs = [counts[j] for j in moved for _ in runs]
     res = optimize.minimize_scalar(

@@ -82,7 +82,7 @@ class DriverNode(LoopNode):
             )
         raw_subscription(self, "std_msgs/msg/Float64", f"{ns}/test/pause", self._on_pause, LATCHED)
         self._button = bool(cfg.get("button", False))
-        self._hand_on = self.kind == "touch" and self.plant.device.hand.behaviour != "none"
+        self._hand_on = self.kind == "touch" and self.plant.device.hand.active
         #: touch: the stylus at rest (the plant does not step) until it is taken (``_taken``)
         self._resting = self.kind == "touch" and (bool(cfg.get("inkwell")) or self._hand_on)
         self.hand_start_ns = -1  # the instant the plant first stepped from (-1: not yet)

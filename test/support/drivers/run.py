@@ -26,6 +26,7 @@ from support.waits import wait_until
 
 NODE = Path(__file__).resolve().parent / "node.py"
 DEADMAN_HELD = "dead-man held"  # the bridge's line when the button is held
+LOOP_UP = "the loop is up"  # the bridge's line when it hands the driver's states on
 DRIVER_SHARE = 0.95  # the test driver's ticks processed within a period of their instant
 #: a test driver runs under SCHED_FIFO at this priority where the machine allows it, as a
 #: controller manager's real-time thread does (a real driver keeps its rate beside a CPU hog)
@@ -92,8 +93,6 @@ def bridge_session(
     )
     try:
         if controls is not None:
-            up = "the loop is up"
-            assert wait_until(lambda: up in graph.output(), 120.0), graph.output()
             controls.hold(graph.output)
         assert graph.wait(180) == 0, graph.output()
     finally:
@@ -134,10 +133,11 @@ class Controls:
         self._button.publish(self._bool(data=held))
 
     def hold(self, output: Callable[[], str], tries: int = 5, wait_s: float = 2.0) -> None:
-        """Press the white button once the bridge subscribes to the driver's buttons, again until
-        the bridge says it sees it held (``output``: the bridge's log so far), as a user presses
-        again: the driver publishes the button only on change, so a press before the bridge's
-        subscription matched the driver's publisher is lost."""
+        """Press the white button once the loop is up (``output``: the bridge's log so far) and
+        the bridge subscribes to the driver's buttons, again until the bridge says it sees it
+        held, as a user presses again: the driver publishes the button only on change, so a
+        press before the bridge's subscription matched the driver's publisher is lost."""
+        assert wait_until(lambda: LOOP_UP in output(), 120.0), output()[-2000:]
         wait_until(lambda: self.node.count_subscribers(self._buttons) > 0, 60.0)
         for _ in range(tries):
             self.press(True)
@@ -235,7 +235,7 @@ class Truth:
         """Of the states published from the first one a command answered to the last, the share
         some command answered (a gate that closed in between, or states lost, lower it)."""
         got = np.unique(self.answered[self.answered >= 0])
-        got = got[np.isin(got, self.stamps)]  # a bridge's zero before any state answers none
+        got = got[got > 0]  # a bridge's zero before any state was handed on is stamped 0
         if len(got) == 0:
             return 0.0
         sent = self.stamps[self.published & (self.stamps >= got[0]) & (self.stamps <= got[-1])]

@@ -13,9 +13,8 @@ import os
 import subprocess
 import sys
 
+from haptic_dob.runtime.cpu_latency import PM_QOS_PATH
 from support.drivers.run import DRIVER_RT_PRIORITY
-
-PM_QOS = "/dev/cpu_dma_latency"
 
 
 @functools.cache
@@ -29,7 +28,7 @@ def launch_args() -> tuple[str, ...]:
         )
         if subprocess.run([sys.executable, "-c", probe], capture_output=True).returncode == 0:
             args += ["--rt-priority", str(DRIVER_RT_PRIORITY)]
-    if os.access(PM_QOS, os.W_OK):
+    if os.access(PM_QOS_PATH, os.W_OK):
         args += ["--cpu-latency", "0"]
     return tuple(args)
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from haptic_dob.bridge.driver_settings import DriverSettings
-from haptic_dob.bridge.loop import BridgeLoop
+from haptic_dob.bridge.loop import ARRIVALS_KEPT, BridgeLoop
 from haptic_dob.bridge.report import bridge_status, write_stats
 from haptic_dob.bridge.settings import SafetySettings
 from haptic_dob.bridge.state import DriverState
@@ -291,3 +291,7 @@ def test_a_late_commands_latency_counts_from_its_own_states_arrival() -> None:
     assert b.latency.n == 2
     assert b.counts()["latency_p99_ms"] == pytest.approx(3.501, abs=2e-3)
     assert b.counts()["latency_p50_ms"] == pytest.approx(0.201, abs=2e-3)
+    for k in range(4, 4 + ARRIVALS_KEPT):  # state 3's arrival is no longer kept
+        b.on_state(state(k), k * 1e-3)
+    assert b.on_command(cmd(3), 0.040) is not None  # timed from the oldest kept (state 4)
+    assert b.latency.n == 3 and b.counts()["latency_p99_ms"] == pytest.approx(36.001, abs=2e-3)

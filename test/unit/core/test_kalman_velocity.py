@@ -95,17 +95,33 @@ def test_a_record_that_loses_states_is_fitted_over_its_runs() -> None:
     assert fit.psd == pytest.approx(1000.0, rel=0.15)
 
 
+def test_a_record_held_still_at_its_start_is_fitted_over_its_motion() -> None:
+    """The same record after 2 s held still (a Touch in its inkwell before the user takes the
+    stylus): the still stretch is left out, and the fit is the motion's alone (within 2 %;
+    fitted with it, the still samples' zero innovations pulled it 10 % down: 858 for 949)."""
+    y = white_jerk_record(1000.0, 10000, 1000)
+    held = np.concatenate([np.zeros(1000), y])
+    stamps = np.arange(len(held), dtype=np.int64) * 2_000_000
+    alone = identify_jerk_psd(stamps[: len(y)], y[:, None], ["j"], [COUNT])
+    fit = identify_jerk_psd(stamps, held[:, None], ["j"], [COUNT])
+    assert fit.psd == pytest.approx(alone.psd, rel=0.02)
+
+
 def test_a_record_without_motion_or_too_short_is_refused() -> None:
     stamps = np.arange(2000, dtype=np.int64) * 2_000_000
     still = np.zeros((2000, 2))
     still[:, 1] = COUNT * (np.arange(2000) // 400 % 2)  # one count back and forth
     with pytest.raises(IdentificationError, match="no joint moved 10 counts"):
         identify_jerk_psd(stamps, still, ["a", "b"], [COUNT, COUNT])
+    y = white_jerk_record(1000.0, 2000, 7)[:, None]
     with pytest.raises(IdentificationError, match=r"hold 0\.8 s after .* needs 1 s"):
-        identify_jerk_psd(stamps[:500], still[:500], ["a", "b"], [COUNT, COUNT])
+        identify_jerk_psd(stamps[:500], y[:500], ["j"], [COUNT])
     lossy = np.delete(stamps, np.arange(100, 2000, 200))  # a state lost every 0.4 s
     with pytest.raises(IdentificationError, match=r"hold 0 s after"):
-        identify_jerk_psd(lossy, still[: len(lossy)], ["a", "b"], [COUNT, COUNT])
+        identify_jerk_psd(lossy, y[: len(lossy)], ["j"], [COUNT])
+    parked = np.concatenate([y[:400], np.full((1600, 1), y[399, 0])])  # moved 0.8 s, then held
+    with pytest.raises(IdentificationError, match=r"device moving hold 0\.6 s after"):
+        identify_jerk_psd(stamps, parked, ["j"], [COUNT])
     moving = np.column_stack([COUNT * np.round(np.linspace(0.0, 0.2, 2000) / COUNT)])
     with pytest.raises(IdentificationError, match=r"j steps by 0\.0004, under half the count"):
         identify_jerk_psd(stamps, moving, ["j"], [1e-3])
