@@ -13,8 +13,8 @@ import os
 import subprocess
 import sys
 
-from haptic_dob.runtime.cpu_latency import PM_QOS_PATH
 from support.drivers.run import DRIVER_RT_PRIORITY
+from support.paths import can_request_cpu_latency
 
 
 @functools.cache
@@ -26,9 +26,14 @@ def launch_args() -> tuple[str, ...]:
             "import os; os.sched_setscheduler(0, os.SCHED_FIFO, "
             f"os.sched_param({DRIVER_RT_PRIORITY}))"
         )
-        if subprocess.run([sys.executable, "-c", probe], capture_output=True).returncode == 0:
+        if (
+            subprocess.run(
+                [sys.executable, "-c", probe], capture_output=True, timeout=60
+            ).returncode
+            == 0
+        ):
             args += ["--rt-priority", str(DRIVER_RT_PRIORITY)]
-    if os.access(PM_QOS_PATH, os.W_OK):
+    if can_request_cpu_latency():
         args += ["--cpu-latency", "0"]
     return tuple(args)
 
