@@ -26,12 +26,8 @@ def launch_args() -> tuple[str, ...]:
             "import os; os.sched_setscheduler(0, os.SCHED_FIFO, "
             f"os.sched_param({DRIVER_RT_PRIORITY}))"
         )
-        if (
-            subprocess.run(
-                [sys.executable, "-c", probe], capture_output=True, timeout=60
-            ).returncode
-            == 0
-        ):
+        tried = subprocess.run([sys.executable, "-c", probe], capture_output=True, timeout=60)
+        if tried.returncode == 0:
             args += ["--rt-priority", str(DRIVER_RT_PRIORITY)]
     if can_request_cpu_latency():
         args += ["--cpu-latency", "0"]
