@@ -33,7 +33,7 @@ from support.waits import wait_until
 pytestmark = [pytest.mark.multiprocess, pytest.mark.slow]
 
 STRAY = """
-import sys, time
+import os, sys, time
 import rclpy
 from rclpy.duration import Duration
 from std_msgs.msg import Float64MultiArray, MultiArrayDimension
@@ -62,9 +62,10 @@ if not pub.wait_for_all_acked(Duration(seconds=20.0)):
     raise SystemExit("the commands were not acknowledged within 20 s")
 said("acknowledged")
 sys.stdin.read()  # in the graph until the test closes stdin, as ros2 topic pub until stopped
-node.destroy_node()
-rclpy.shutdown()
-said("shut down")
+said("leaving")
+# no teardown: rclpy's hung once for over 30 s after every command was acknowledged (a fresh
+# make test, 2026-11-28); the stray leaves as a killed ros2 topic pub does
+os._exit(0)
 """
 #: (node name, layout label) of each stray publisher
 STRAYS = (("stray_bare", ""), ("stray_stamped", "effort@0"), ("stray_guess", "effort@0#0123abcd"))
