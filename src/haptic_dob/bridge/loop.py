@@ -3,7 +3,7 @@
 ``on_state`` turns driver state k into the loop's sample k (q, q', the effort in force over
 [k-1, k) by the driver's clock, ``DriverClock``; the tip's point and velocity; the driver's
 stamp); ``on_command`` turns the loop's command for it into the driver's at once (``CommandMap``,
-``CommandLimiter``). Every way out is zero:
+``CommandLimiter``), and ``book`` counts and times it after the send. Every way out is zero:
 
 - before ``start``, after ``stop``, and while the dead-man is released or never seen: zero on
   every state;
@@ -119,6 +119,9 @@ class BridgeLoop:
         #: latency counts from its own state's arrival
         self._arrivals: deque[tuple[int, float]] = deque(maxlen=ARRIVALS_KEPT)
         self.latency = LatencyHistogram()  # s, state arrival -> a command for it taken
+        #: the newest command taken and not yet booked: its stamp, monotonic s taken, whether
+        #: it answers the newest state, and that state's deadline (monotonic s)
+        self._taken: tuple[int, float, bool, float] | None = None
         self.states = self.on_time = self.late = 0
         self.refused = self.dropped = self.gated = self.zeros = 0
         self.state_trips = self.deadman_releases = self.repeated = 0
@@ -130,6 +133,7 @@ class BridgeLoop:
         """Driver state ``s`` arrived at monotonic ``now`` (s), on the system clock at
         ``now_ns`` (None: not known): the loop's sample (None while not handing on) and a zero
         to send first (None when none is due)."""
+        self.book()
         if self.stopping:
             return None, None
         if s.stamp_ns <= self.newest_ns:  # a stamp that did not advance: not a new state
@@ -185,7 +189,8 @@ class BridgeLoop:
     # --- the loop's command ----------------------------------------------------------------
     def on_command(self, cmd: EffortCommand, now: float) -> Send | None:
         """The loop's command arrived at monotonic ``now`` (s): the driver's command, a zero
-        (refused), or None (dropped: stale, blocked, or after the stop)."""
+        (refused), or None (dropped: stale, blocked, or after the stop). ``book`` counts it."""
+        self.book()
         if self.stopping:
             return None
         stamp = self.newest_ns if cmd.stamp_ns is None else cmd.stamp_ns
@@ -198,16 +203,8 @@ class BridgeLoop:
             return self._zero(stamp, "refused a command of the wrong length or with NaN/inf", now)
         self.watchdog.fed(self.k)
         self.answered_ns = stamp
-        if stamp == self.newest_ns:  # before the driver's next cycle, or late for it
-            if now < self._newest_instant + self.period_s:
-                self.on_time += 1
-            else:
-                self.late += 1
-        arrived = next((t for k, t in reversed(self._arrivals) if k == stamp), None)
-        if arrived is None and stamp < self._arrivals[0][0]:  # older than kept: at least this
-            arrived = self._arrivals[0][1]
-        if arrived is not None:  # an unlabelled command answers the newest: found too
-            self.latency.add(now - arrived)
+        newest = stamp == self.newest_ns
+        self._taken = (stamp, now, newest, self._newest_instant + self.period_s)
         if not self.deadman_held:
             self.gated += 1
             return None
@@ -217,6 +214,24 @@ class BridgeLoop:
             return self._zero(stamp, "the command mapped to NaN/inf", now)
         self._sent.add(now, u)
         return Send(tuple(x * self.scale for x in u), stamp, "")
+
+    def book(self) -> None:
+        """Count the command taken last as on time or late and time it from its state's
+        arrival: off the command's path, after its send (each call in books it first too)."""
+        if self._taken is None:
+            return
+        stamp, now, newest, deadline = self._taken
+        self._taken = None
+        if newest:  # before the driver's next cycle, or late for it
+            if now < deadline:
+                self.on_time += 1
+            else:
+                self.late += 1
+        arrived = next((t for k, t in reversed(self._arrivals) if k == stamp), None)
+        if arrived is None and stamp < self._arrivals[0][0]:  # older than kept: at least this
+            arrived = self._arrivals[0][1]
+        if arrived is not None:  # an unlabelled command answers the newest: found too
+            self.latency.add(now - arrived)
 
     # --- safety inputs and time -------------------------------------------------------------
     def on_deadman(self, held: bool, now: float) -> Send | None:
@@ -282,6 +297,7 @@ class BridgeLoop:
 
     def counts(self) -> dict[str, float]:
         """What the bridge counted so far (the stats file and the diagnostics)."""
+        self.book()
         total = self.on_time + self.late
         return {
             "states": self.states,

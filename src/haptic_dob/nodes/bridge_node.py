@@ -170,6 +170,7 @@ class BridgeNode(LoopNode):
     def admit(self, cmd: EffortCommand) -> None:
         """Every command the command authority lets through (the loop's own controller's)."""
         self._send(self.loop.on_command(cmd, time.monotonic()))
+        self.loop.book()  # off the command's path: after its send
 
     def _send(self, send: Send | None) -> None:
         if send is not None:

@@ -42,6 +42,12 @@ def cmd(k: int | None, *effort: float) -> EffortCommand:
     return EffortCommand(None if k is None else k * T, effort or (1.0, 0.0, 0.0))
 
 
+def timing(b: BridgeLoop) -> tuple[float, float]:
+    """The commands on time and late so far (the counts book the command taken last)."""
+    c = b.counts()
+    return c["commands_on_time"], c["commands_late"]
+
+
 def test_zero_until_the_loop_is_up_then_sample_and_command_at_once() -> None:
     b = bridge()
     sample, zero = b.on_state(state(1), 0.0)
@@ -53,7 +59,7 @@ def test_zero_until_the_loop_is_up_then_sample_and_command_at_once() -> None:
     assert sample.stamp_ns == 2 * T and sample.ee_position == pytest.approx((0.01, 0.0, 0.0))
     send = b.on_command(cmd(2, 2.0, -1.0, 9.0), 0.0012)
     assert send is not None and send.values == (2.0, -1.0, 5.0) and send.stamp_ns == 2 * T
-    assert b.limiter.clamped == 1 and b.on_time == 1
+    assert b.limiter.clamped == 1 and timing(b) == (1, 0)
 
 
 @pytest.mark.parametrize("delay", [0, 1])
@@ -152,13 +158,13 @@ def test_a_command_sent_after_the_drivers_next_instant_is_late_and_not_in_force_
     for k in range(1, 5):
         efforts[k] = b.on_state(state(k), k * 1e-3 + 50e-6)[0].effort[0]  # type: ignore[union-attr]
         b.on_command(cmd(k, k / 2, 0.0, 0.0), k * 1e-3 + 150e-6)
-    assert (b.on_time, b.late) == (4, 0)
+    assert timing(b) == (4, 0)
     efforts[5] = b.on_state(state(5), 6.2e-3)[0].effort[0]  # type: ignore[union-attr]
     assert b.on_command(cmd(5, 2.5, 0.0, 0.0), 6.3e-3) is not None  # late, but sent
     efforts[6] = b.on_state(state(6), 6.35e-3)[0].effort[0]  # type: ignore[union-attr]
     b.on_command(cmd(6, 3.0, 0.0, 0.0), 6.4e-3)  # on time for state 7's instant (7.05 ms)
     efforts[7] = b.on_state(state(7), 7.05e-3)[0].effort[0]  # type: ignore[union-attr]
-    assert (b.on_time, b.late) == (5, 1)
+    assert timing(b) == (5, 1)
     efforts[8] = b.on_state(state(8), 8.05e-3)[0].effort[0]  # type: ignore[union-attr]
     if delay == 0:  # the newest sent before state k's instant
         assert [efforts[k] for k in range(5, 9)] == [2.0, 2.0, 3.0, 3.0]
@@ -202,7 +208,7 @@ def test_on_one_clock_a_states_instant_is_its_stamp() -> None:
     assert heard(4, t3 + 1e-3 + 200e-6) == 0.0  # not in force over [3, 4)
     b.on_command(cmd(4, 2.0, 0.0, 0.0), t3 + 2e-3 - 50e-6)  # before state 5's
     assert heard(5, t3 + 2e-3 + 200e-6) == 2.0
-    assert (b.on_time, b.late) == (1, 1) and b.counts()["state_age_ms"] == pytest.approx(0.2)
+    assert timing(b) == (1, 1) and b.counts()["state_age_ms"] == pytest.approx(0.2)
 
 
 def test_one_clock_is_told_by_an_age_under_a_period_and_then_kept() -> None:
@@ -234,7 +240,7 @@ def test_late_commands_are_counted_per_state() -> None:
     b.on_state(state(2), 0.001)
     b.on_state(state(3), 0.002)  # state 2 got no command before state 3
     assert b.on_command(cmd(2), 0.0025) is not None  # late, still newer than the last answered
-    assert (b.on_time, b.late) == (1, 1)
+    assert timing(b) == (1, 1)
     assert b.counts()["on_time_pct"] == pytest.approx(50.0)
 
 
@@ -288,10 +294,32 @@ def test_a_late_commands_latency_counts_from_its_own_states_arrival() -> None:
     b.on_state(state(2), 0.001)
     b.on_state(state(3), 0.002)
     assert b.on_command(cmd(2), 0.0045) is not None  # 3.5 ms after state 2 arrived
+    b.book()
     assert b.latency.n == 2
     assert b.counts()["latency_p99_ms"] == pytest.approx(3.501, abs=2e-3)
     assert b.counts()["latency_p50_ms"] == pytest.approx(0.201, abs=2e-3)
     for k in range(4, 4 + ARRIVALS_KEPT):  # state 3's arrival is no longer kept
         b.on_state(state(k), k * 1e-3)
     assert b.on_command(cmd(3), 0.040) is not None  # timed from the oldest kept (state 4)
+    b.book()
     assert b.latency.n == 3 and b.counts()["latency_p99_ms"] == pytest.approx(36.001, abs=2e-3)
+
+
+def test_a_command_is_counted_after_its_send_not_before() -> None:
+    """``on_command`` hands the command out without counting or timing it; ``book`` (the node
+    calls it after the send), the next state or the counts book it, with the timing taken when
+    it came, against the state it answered."""
+    b = bridge()
+    b.start()
+    b.on_state(state(1), 0.0)
+    assert b.on_command(cmd(1), 0.0002) is not None
+    assert (b.on_time, b.late, b.latency.n) == (0, 0, 0)  # nothing on the command's path
+    b.book()
+    assert (b.on_time, b.late, b.latency.n) == (1, 0, 1)
+    b.book()  # booked once
+    assert (b.on_time, b.latency.n) == (1, 1)
+    b.on_state(state(2), 0.001)
+    assert b.on_command(cmd(2), 0.0025) is not None  # 1.5 ms: late for state 3's instant
+    b.on_state(state(3), 0.0026)  # the next state books it, against state 2's deadline
+    assert timing(b) == (1, 1) and b.latency.n == 2
+    assert b.counts()["latency_p99_ms"] == pytest.approx(1.501, abs=2e-3)
