@@ -1,11 +1,11 @@
 """A simulated multi-DOF arm (the PHANToM 1.5, any URDF arm): plant, encoders, sensor and hand.
 
-Plant: any ``DeviceModel``, ``D(q) q'' + C(q, q') q' + G(q) + friction(q') = tau + J^T F_tip``;
-``F_tip`` sums the hand's force, an optional known external force and the contact's
-(``haptic_sim.arm.contact``, at every integration stage; ``contact_force_true`` at the sample).
-``substeps`` RK4 steps per control period (10 at 1 kHz), the effort held over the period, the
-hand's reference and the external force over each sub-step. Coulomb friction is smoothed to
-``Fc tanh(q' / eps)`` (``arm_dynamics.coulomb_smoothing``; docs/design/friction.md). Each
+Plant: any ``DeviceModel``, its acceleration at each stage ``haptic_sim.arm.acceleration``'s
+(the hand's force, an optional known external force and the contact's on the tip;
+``contact_force_true`` at the sample). ``substeps`` RK4 steps per control period (10 at 1 kHz),
+the effort held over the period, the hand's reference and the external force over each
+sub-step. Coulomb friction is smoothed to ``Fc tanh(q' / eps)``
+(``arm_dynamics.coulomb_smoothing``; docs/design/friction.md). Each
 joint's effort is saturated at ``joint_effort_limits``, else the model's limits, else the effort
 that gives ``max_force_n`` at the tip at the start pose (``haptic_sim.arm.params``).
 Encoders (``haptic_sim.arm.encoders``): counts of the joints or of ``encoder_matrix``'s rows;
@@ -17,7 +17,6 @@ with the handle (``D + m_h J^T J``) held by a grip spring and damper to its refe
 from __future__ import annotations
 
 import math
-from typing import Any, cast
 
 import numpy as np
 
@@ -25,8 +24,9 @@ from haptic_dob.core.environment import VirtualWall
 from haptic_dob.core.models.base import DeviceModel, Vec
 from haptic_dob.core.validation import positive, unit_vector, vector
 from haptic_msgs_py.stamps import period_ns
+from haptic_sim.arm.acceleration import ArmAcceleration
 from haptic_sim.arm.contact import contact_of
-from haptic_sim.arm.dynamics import coulomb_smoothing, dynamics_and_tip, mass_and_bias, solve
+from haptic_sim.arm.dynamics import coulomb_smoothing, mass_and_bias
 from haptic_sim.arm.encoders import Encoders
 from haptic_sim.arm.params import ArmDeviceParams, effort_limits
 from haptic_sim.device.sample import DeviceSample
@@ -35,7 +35,6 @@ from haptic_sim.hand_space import hand_references
 from haptic_sim.sensor import ForceSensor, ForceSensorParams
 
 _ZERO3 = np.zeros(3)
-_NO_J = np.zeros((3, 0))  # the Jacobian slot of ``_last`` on the ABA path (unused there)
 
 
 class SimulatedArm:
@@ -84,14 +83,6 @@ class SimulatedArm:
         else:
             q0 = np.array(getattr(model, "home", np.zeros(n)), dtype=np.float64)
         self._dyn = mass_and_bias(model)
-        self._dyn_tip = dynamics_and_tip(model)
-        # pinocchio's ABA where the model has it (no mass matrix, no solve): the free arm and an
-        # arm under tip forces (contact, an external force), not one with a hand's mass on it
-        self._aba = bool(getattr(model, "_has_forward_dynamics", False))
-        if self._aba:
-            self._fd = cast(Any, model)._forward_dynamics
-            self._tip_motion = cast(Any, model)._tip_motion
-        self._viscous = np.asarray(getattr(model, "viscous", np.zeros(self.dof)), dtype=np.float64)
         self._coulomb, self._coulomb_eps = coulomb_smoothing(model, self._dyn, q0, self.dt_physics)
         self.effort_limits = effort_limits(dev, model, q0)
         #: actuator saturation per joint (N m or N), the ``SimulatedDevice`` protocol's name
@@ -114,10 +105,17 @@ class SimulatedArm:
         )
         self._sensors = [ForceSensor(self.sensor_params, self.dt_physics, r) for r in rngs[3:]]
         self.contact = contact_of(contact)
-        self._contact = None if self.contact is None else self.contact.force
         self._needs_tip = h.active or self._ext_on_step is not None or self.contact is not None
         self._kh, self._bh = h.stiffness_n_per_m, h.damping_n_s_per_m
         self._mh = h.mass_kg if h.active else 0.0
+        self._accel = ArmAcceleration(
+            model,
+            self._dyn,
+            (self._coulomb, self._coulomb_eps),
+            None if self.contact is None else self.contact.force,
+            self._needs_tip,
+            (self._kh, self._bh, self._mh),
+        )
         self._exact_velocity = dev.velocity == "exact"
         # state
         self._k = 0
@@ -174,41 +172,6 @@ class SimulatedArm:
         self._sample = self._make_sample()
 
     # --- physics ---------------------------------------------------------------------------
-    def _accel(self, q: Vec, v: Vec, tau: Vec, f_ext: Vec, ref: tuple[Vec, Vec, Vec] | None) -> Vec:
-        """Joint acceleration; with tip forces also records (grip, J, J' q', f_ext) in ``_last``."""
-        if self._aba and ref is None:  # b q' + Fc tanh(q' / eps) in one go, then ABA
-            if self._coulomb is not None:
-                tau = tau - self._viscous * v - self._coulomb * np.tanh(v / self._coulomb_eps)
-            else:
-                tau = tau - self._viscous * v
-            if not self._needs_tip:
-                a: Vec = self._fd(q, v, tau, None)
-                return a
-            if self._contact is not None:
-                f_ext = f_ext + self._contact(*self._tip_motion(q, v))
-            self._last = (_ZERO3, _NO_J, _ZERO3, f_ext)  # J unused without a hand's grip
-            a = self._fd(q, v, tau, f_ext)
-            return a
-        if self._coulomb is not None:  # the model's Fc sgn(q') -> Fc tanh(q' / eps)
-            fc = self._coulomb
-            tau = tau - fc * (np.tanh(v / self._coulomb_eps) - np.sign(v))
-        if not self._needs_tip:
-            D, h = self._dyn(q, v)
-            return solve(D, tau - h)
-        D, h, p, J, jdv = self._dyn_tip(q, v)
-        if self._contact is not None:
-            f_ext = f_ext + self._contact(p, J @ v)
-        Jt = J.T
-        if ref is None:
-            self._last = (_ZERO3, J, jdv, f_ext)
-            return solve(D, tau - h + Jt @ f_ext)
-        # grip = k_h (x_r - p) + b_h (x_r' - J q') + f_ff, with ref[0] = k_h x_r + b_h x_r' + f_ff
-        grip = ref[0] - self._kh * p - self._bh * (J @ v)
-        self._last = (grip, J, jdv, f_ext)
-        if self._mh > 0.0:
-            return solve(D + self._mh * (Jt @ J), tau - h + Jt @ (grip + f_ext - self._mh * jdv))
-        return solve(D, tau - h + Jt @ (grip + f_ext))
-
     def _reference(self) -> tuple[Vec, Vec, Vec] | None:
         """Hand reference at the current physics step: position, velocity, feed-forward force."""
         if not self._ref:
@@ -237,7 +200,7 @@ class SimulatedArm:
             )
             a1 = self._accel(q, v, tau, f_ext, ref)
             if self._needs_tip:
-                grip, J, jdv, external = self._last
+                grip, J, jdv, external = self._accel.last
                 hand = grip - self._mh * (J @ a1 + jdv) if ref is not None else grip
                 total = hand + external
                 for s, f in zip(self._sensors, total.tolist(), strict=True):
