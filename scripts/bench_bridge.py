@@ -142,6 +142,7 @@ def one_run(profile: str) -> dict[str, float]:
         "bridge_p50_us": bridge["latency_p50_ms"] * 1e3,
         "ticked_pct": 100.0 * truth.ticked_share(),
         "tick_late_p99_us": c["tick_late_p99_ms"] * 1e3,
+        "out_late_p50_us": c["state_out_late_p50_ms"] * 1e3,
     }
 
 
@@ -160,7 +161,8 @@ def bench_bridge(repeat: int) -> str:
             f"(p99 {med['latency_p99_us']:.0f}), {statistics.median(ratio):.1f}x one raw hop "
             f"({med['hop_us']:.0f} us; floor 2x), inside the bridge {med['bridge_p50_us']:.0f} "
             f"us; on time {on_time} %; within a period of the state {within} %; driver ticked "
-            f"{ticked} % of its periods, p99 {med['tick_late_p99_us']:.0f} us after its instant"
+            f"{ticked} % of its periods, p99 {med['tick_late_p99_us']:.0f} us after its instant, "
+            f"its states out p50 {med['out_late_p50_us']:.0f} us after their instants"
         )
     return "; ".join(parts)
 

@@ -118,7 +118,9 @@ def kept_real_time(
     return (
         f"{100 * on_time:.1f} % of the commands reached the test driver before its next state "
         f"at {rate_hz:g} Hz on this machine now, {scheduling.described()} (the chain "
-        f"presumes {100 * presumed:g} %)"
+        f"presumes {100 * presumed:g} %; the driver's states went out "
+        f"{c.get('state_out_late_p50_ms', math.nan):.2f} ms after their instants, p99 "
+        f"{c.get('state_out_late_p99_ms', math.nan):.2f} ms, of a {1e3 / rate_hz:g} ms period)"
     )
 
 

@@ -110,6 +110,8 @@ class DriverNode(LoopNode):
         self.commands: list[tuple[float, ...]] = []  # arrival (monotonic), stamp, values...
         self.tick_stamps: list[int] = []  # each tick's stamp, exact (ns)
         self.tick_late: list[float] = []  # each tick's processing after its instant (s)
+        #: each published state's going out after its instant (s): a Touch's physics is on it
+        self.out_late: list[float] = []
         self.answered: list[int] = []  # the stamp each command answers, exact (-1: none)
         self.last_command: tuple[float, ...] = ()
 
@@ -202,6 +204,7 @@ class DriverNode(LoopNode):
             self.plant.apply(self._effort())
 
     def _publish(self, stamp: int, s: Any) -> None:
+        self.out_late.append(time.monotonic() - self.deadline)
         self._stamp = stamp
         self._sent_at[stamp] = time.time_ns()
         if len(self._sent_at) > 256:  # states never answered (a pause of the loop's commands)
@@ -252,9 +255,10 @@ class DriverNode(LoopNode):
             if row[2] and first_ns <= st <= last_ns
         )
 
-    def _late_ms(self, pct: float) -> float:
-        """A percentile of the ticks' processing after their instants (ms)."""
-        return float(np.percentile(self.tick_late, pct)) * 1e3 if self.tick_late else math.nan
+    @staticmethod
+    def _ms(values: list[float], pct: float) -> float:
+        """A percentile of ``values`` (s), in ms (NaN: none)."""
+        return float(np.percentile(values, pct)) * 1e3 if values else math.nan
 
     def on_shutdown(self) -> None:
         self.io.receive(None)  # the last commands that came (a bridge's zero on its way out)
@@ -273,8 +277,10 @@ class DriverNode(LoopNode):
             "missed_ticks": self.missed_ticks,
             "latency_p50_ms": self.latency.percentile(50) * 1e3,
             "latency_p99_ms": self.latency.percentile(99) * 1e3,
-            "tick_late_p50_ms": self._late_ms(50),
-            "tick_late_p99_ms": self._late_ms(99),
+            "tick_late_p50_ms": self._ms(self.tick_late, 50),
+            "tick_late_p99_ms": self._ms(self.tick_late, 99),
+            "state_out_late_p50_ms": self._ms(self.out_late, 50),
+            "state_out_late_p99_ms": self._ms(self.out_late, 99),
             "nonfinite_dropped": self.io.nonfinite_dropped,
             "size_errors": getattr(self.io, "size_errors", 0),
         }
