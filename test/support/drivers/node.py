@@ -43,6 +43,10 @@ ARM_JOINTS = tuple(f"joint{i}" for i in range(1, 8))
 GRIPPER = "gripper_finger_joint"  # an extra joint the arm's model does not have
 FD_JOINTS = ("fd_x", "fd_y", "fd_z")
 CATCH_UP = 20  # periods a late tick catches up; a longer stall moves the grid on
+#: touch: when in a period (its shares) the driver looks for the answer to its newest state, to
+#: step the plant on it then rather than at the next instant, before that state goes out; on
+#: one CPU it does not look (each look's wakeup would take the loop's CPU)
+LOOKS = (0.3, 0.5, 0.7, 0.85)
 
 
 class DriverNode(LoopNode):
@@ -90,6 +94,9 @@ class DriverNode(LoopNode):
         self._force = np.zeros(3)  # touch: the Cartesian force in force (base frame)
         self.deadline = time.monotonic() + 0.2
         self.paused_until = 0.0
+        self._looks: list[float] = []  # touch: monotonic s of this period's looks still to come
+        self._look_at = LOOKS if len(os.sched_getaffinity(0)) >= 2 else ()
+        self._ahead = False  # touch: the plant stepped over this period on its state's answer
         self._k = -1  # ticks done (sample index)
         self._n = 0  # the grid instant of the next tick (periods from the first)
         self._t0_ns = 0  # the system clock at the first tick's instant: the grid's origin
@@ -143,9 +150,12 @@ class DriverNode(LoopNode):
 
     # --- the cycle ---------------------------------------------------------------------------
     def next_wakeup(self) -> float | None:
-        return self.deadline
+        return min(self._looks[0], self.deadline) if self._looks else self.deadline
 
     def on_wakeup(self, now: float) -> None:
+        if self._looks and now < self.deadline:
+            self._look(now)
+            return
         if self._k < 0:
             self.get_logger().info(
                 f"{TICKING} at {self.cfg['rate_hz']} Hz under {self.cfg.get('scheduling')}"
@@ -168,7 +178,8 @@ class DriverNode(LoopNode):
         already stepped over the period before the instant at the end of the last tick, with
         the command written then, as the device moves on its own while the driver waits; then
         it steps over the next period with this update's command. Touch: the newest force acts
-        over the period before the instant, so the plant steps then. A tick processed late
+        over the period before the instant: the plant stepped on the answer to the last state
+        when ``_look`` found it, else it steps now. A tick processed late
         first catches up the ticks already due, their states going out at once, stamped their
         instants (``CATCH_UP`` at most: then the grid moves on and states are lost)."""
         stamp = self._t0_ns + self._n * self.period_ns
@@ -176,13 +187,10 @@ class DriverNode(LoopNode):
         if self._k >= 0 and self.on_time and self._stamp not in (self._answered, self._marked):
             self._unanswered += 1
             self._marked = self._stamp
-        if self.kind == "touch" and self._k >= 0:
-            effort = self._effort()
-            self._resting = self._resting and not self._taken()
-            if not self._resting:
-                self.plant.apply(effort)
-                if self.hand_start_ns < 0:
-                    self.hand_start_ns = stamp - self.period_ns
+        self._looks = []
+        if self.kind == "touch" and self._k >= 0 and not self._ahead:
+            self._step_touch(stamp - self.period_ns)
+        self._ahead = False
         self._k += 1
         s = self.plant.sample()
         if self.kind == "touch":
@@ -199,9 +207,33 @@ class DriverNode(LoopNode):
         self.missed_ticks += now - self.deadline > self.period_s
         self._n += 1
         self.deadline += self.period_s
+        if self.kind == "touch" and publish:
+            at = self.deadline - self.period_s
+            self._looks = [t for t in (at + f * self.period_s for f in self._look_at) if t > now]
         self.plant.prepare()
         if self.kind != "touch":  # the period to the next instant, ahead of it
             self.plant.apply(self._effort())
+
+    def _step_touch(self, start_ns: int) -> None:
+        """Touch: the plant over the period from instant ``start_ns`` with the newest force."""
+        effort = self._effort()
+        self._resting = self._resting and not self._taken()
+        if not self._resting:
+            self.plant.apply(effort)
+            if self.hand_start_ns < 0:
+                self.hand_start_ns = start_ns
+
+    def _look(self, now: float) -> None:
+        """Touch, at monotonic ``now`` within a period: take the forces DDS received so far;
+        the newest state's answer among them steps the plant over the period at once (a real
+        driver's next state is read, not computed: it goes out at its instant). A force that
+        comes after that step acts from the next period."""
+        self._looks = [t for t in self._looks if t > now]
+        self.io.receive(time.time_ns())
+        if self._answered == self._stamp:
+            self._step_touch(self._stamp)
+            self._ahead = True
+            self._looks = []
 
     def _publish(self, stamp: int, s: Any) -> None:
         self.out_late.append(time.monotonic() - self.deadline)
