@@ -3,7 +3,7 @@
 ``on_state`` turns driver state k into the loop's sample k (q, q', the effort in force over
 [k-1, k) by the driver's clock, ``DriverClock``; the tip's point and velocity; the driver's
 stamp); ``on_command`` turns the loop's command for it into the driver's at once (``CommandMap``,
-``CommandLimiter``), and ``book`` counts and times it after the send. Every way out is zero:
+``CommandLimiter``); ``book`` counts it after the send (``AnswerTiming``). Every way out is zero:
 
 - before ``start``, after ``stop``, and while the dead-man is released or never seen: zero on
   every state;
@@ -24,6 +24,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from haptic_dob.bridge.answers import AnswerTiming
 from haptic_dob.bridge.command import CommandLimiter, CommandMap
 from haptic_dob.bridge.driver_settings import DriverSettings
 from haptic_dob.bridge.settings import SafetySettings
@@ -31,14 +32,10 @@ from haptic_dob.bridge.state import DriverState
 from haptic_dob.bridge.timeline import DriverClock, SentLog
 from haptic_dob.core.models.base import DeviceModel
 from haptic_dob.core.watchdog import CommandWatchdog
-from haptic_dob.runtime.latency import LatencyHistogram
 from haptic_msgs_py.stamps import period_ns
 from haptic_msgs_py.values import EffortCommand
 
 Vec3 = tuple[float, float, float]
-#: states whose arrival the bridge keeps for its latency: a command answering an older one is
-#: timed from the oldest kept (a lower bound, as the histogram's top bin is)
-ARRIVALS_KEPT = 32
 
 
 class LoopSample(NamedTuple):
@@ -115,14 +112,8 @@ class BridgeLoop:
         self.newest_ns = -1  # stamp of the newest state handed on
         self.answered_ns = -1  # stamp of the newest sample commanded
         self._newest_q: tuple[float, ...] = self._zero_model
-        #: (stamp ns, monotonic arrival s) of the newest states handed on: a late command's
-        #: latency counts from its own state's arrival
-        self._arrivals: deque[tuple[int, float]] = deque(maxlen=ARRIVALS_KEPT)
-        self.latency = LatencyHistogram()  # s, state arrival -> a command for it taken
-        #: the newest command taken and not yet booked: its stamp, monotonic s taken, whether
-        #: it answers the newest state, and that state's deadline (monotonic s)
-        self._taken: tuple[int, float, bool, float] | None = None
-        self.states = self.on_time = self.late = 0
+        self.timing = AnswerTiming()  # on time, late, latency (``book``: after the send)
+        self.states = 0
         self.refused = self.dropped = self.gated = self.zeros = 0
         self.state_trips = self.deadman_releases = self.repeated = 0
 
@@ -154,11 +145,9 @@ class BridgeLoop:
         self._instants.append(instant)
         if not self.started:
             return None, self._zero(s.stamp_ns, "the loop is not up yet", now)
-        if self.answered_ns != self.newest_ns and self.on_time + self.late:
-            self.late += 1  # the previous state got no command at all
+        self.timing.arrived(s.stamp_ns, now, self.answered_ns != self.newest_ns)
         self.k += 1
         self.newest_ns, self._newest_q = s.stamp_ns, s.q
-        self._arrivals.append((s.stamp_ns, now))
         self._newest_instant = instant
         zero = None
         if self.watchdog.due(self.k, self.command_timeout_s):
@@ -204,7 +193,7 @@ class BridgeLoop:
         self.watchdog.fed(self.k)
         self.answered_ns = stamp
         newest = stamp == self.newest_ns
-        self._taken = (stamp, now, newest, self._newest_instant + self.period_s)
+        self.timing.taken(stamp, now, newest, self._newest_instant + self.period_s)
         if not self.deadman_held:
             self.gated += 1
             return None
@@ -216,22 +205,8 @@ class BridgeLoop:
         return Send(tuple(x * self.scale for x in u), stamp, "")
 
     def book(self) -> None:
-        """Count the command taken last as on time or late and time it from its state's
-        arrival: off the command's path, after its send (each call in books it first too)."""
-        if self._taken is None:
-            return
-        stamp, now, newest, deadline = self._taken
-        self._taken = None
-        if newest:  # before the driver's next cycle, or late for it
-            if now < deadline:
-                self.on_time += 1
-            else:
-                self.late += 1
-        arrived = next((t for k, t in reversed(self._arrivals) if k == stamp), None)
-        if arrived is None and stamp < self._arrivals[0][0]:  # older than kept: at least this
-            arrived = self._arrivals[0][1]
-        if arrived is not None:  # an unlabelled command answers the newest: found too
-            self.latency.add(now - arrived)
+        """Count and time the command taken last (``AnswerTiming.book``): after its send."""
+        self.timing.book()
 
     # --- safety inputs and time -------------------------------------------------------------
     def on_deadman(self, held: bool, now: float) -> Send | None:
@@ -298,15 +273,16 @@ class BridgeLoop:
     def counts(self) -> dict[str, float]:
         """What the bridge counted so far (the stats file and the diagnostics)."""
         self.book()
-        total = self.on_time + self.late
+        t = self.timing
+        total = t.on_time + t.late
         return {
             "states": self.states,
             "handed_on": self.k,
-            "commands_on_time": self.on_time,
-            "commands_late": self.late,
-            "on_time_pct": 100.0 * self.on_time / total if total else math.nan,
-            "latency_p50_ms": self.latency.percentile(50) * 1e3,
-            "latency_p99_ms": self.latency.percentile(99) * 1e3,
+            "commands_on_time": t.on_time,
+            "commands_late": t.late,
+            "on_time_pct": 100.0 * t.on_time / total if total else math.nan,
+            "latency_p50_ms": t.latency.percentile(50) * 1e3,
+            "latency_p99_ms": t.latency.percentile(99) * 1e3,
             "refused_commands": self.refused,
             "dropped_commands": self.dropped,
             "gated_commands": self.gated,

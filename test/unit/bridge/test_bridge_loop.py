@@ -9,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
+from haptic_dob.bridge.answers import ARRIVALS_KEPT
 from haptic_dob.bridge.driver_settings import DriverSettings
-from haptic_dob.bridge.loop import ARRIVALS_KEPT, BridgeLoop
+from haptic_dob.bridge.loop import BridgeLoop
 from haptic_dob.bridge.report import bridge_status, write_stats
 from haptic_dob.bridge.settings import SafetySettings
 from haptic_dob.bridge.state import DriverState
@@ -295,14 +296,16 @@ def test_a_late_commands_latency_counts_from_its_own_states_arrival() -> None:
     b.on_state(state(3), 0.002)
     assert b.on_command(cmd(2), 0.0045) is not None  # 3.5 ms after state 2 arrived
     b.book()
-    assert b.latency.n == 2
+    assert b.timing.latency.n == 2
     assert b.counts()["latency_p99_ms"] == pytest.approx(3.501, abs=2e-3)
     assert b.counts()["latency_p50_ms"] == pytest.approx(0.201, abs=2e-3)
     for k in range(4, 4 + ARRIVALS_KEPT):  # state 3's arrival is no longer kept
         b.on_state(state(k), k * 1e-3)
     assert b.on_command(cmd(3), 0.040) is not None  # timed from the oldest kept (state 4)
     b.book()
-    assert b.latency.n == 3 and b.counts()["latency_p99_ms"] == pytest.approx(36.001, abs=2e-3)
+    assert b.timing.latency.n == 3 and b.counts()["latency_p99_ms"] == pytest.approx(
+        36.001, abs=2e-3
+    )
 
 
 def test_a_command_is_counted_after_its_send_not_before() -> None:
@@ -313,13 +316,17 @@ def test_a_command_is_counted_after_its_send_not_before() -> None:
     b.start()
     b.on_state(state(1), 0.0)
     assert b.on_command(cmd(1), 0.0002) is not None
-    assert (b.on_time, b.late, b.latency.n) == (0, 0, 0)  # nothing on the command's path
+    assert (b.timing.on_time, b.timing.late, b.timing.latency.n) == (
+        0,
+        0,
+        0,
+    )  # nothing on the command's path
     b.book()
-    assert (b.on_time, b.late, b.latency.n) == (1, 0, 1)
+    assert (b.timing.on_time, b.timing.late, b.timing.latency.n) == (1, 0, 1)
     b.book()  # booked once
-    assert (b.on_time, b.latency.n) == (1, 1)
+    assert (b.timing.on_time, b.timing.latency.n) == (1, 1)
     b.on_state(state(2), 0.001)
     assert b.on_command(cmd(2), 0.0025) is not None  # 1.5 ms: late for state 3's instant
     b.on_state(state(3), 0.0026)  # the next state books it, against state 2's deadline
-    assert timing(b) == (1, 1) and b.latency.n == 2
+    assert timing(b) == (1, 1) and b.timing.latency.n == 2
     assert b.counts()["latency_p99_ms"] == pytest.approx(1.501, abs=2e-3)
