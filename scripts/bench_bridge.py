@@ -37,6 +37,8 @@ from support.drivers.run import SLIDE_HAND, Controls, Truth, start  # noqa: E402
 RUN_S = 10.0
 #: ``taskset -c`` CPU list of the driver and the loop (``--cpus``); empty: the process's CPUs
 CPUS: list[str] = []
+#: the profiles to run (``--profiles``); empty: every one of ``PROFILES``
+ONLY: list[str] = []
 #: name -> (config, the test driver, the bridge node's name in the launch, haptic-launch's extra)
 PROFILES: dict[str, tuple[str, dict[str, object], str, list[str]]] = {
     "fd": (
@@ -149,7 +151,7 @@ def one_run(profile: str) -> dict[str, float]:
 def bench_bridge(repeat: int) -> str:
     """Driver state -> command latency through the bridge (composed) against one raw hop."""
     parts = []
-    for profile in PROFILES:
+    for profile in ONLY or PROFILES:
         runs = [one_run(profile) for _ in range(repeat)]
         med = {k: statistics.median(r[k] for r in runs) for k in runs[0]}
         ratio = [r["latency_p50_us"] / r["hop_us"] for r in runs]

@@ -19,7 +19,7 @@ from pathlib import Path
 # bench_timer_floor (the machine's own stalls), bench_margin (the graph against its floors)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_batch import bench_batch_session, bench_observer_update, bench_velocity
-from bench_bridge import CPUS, bench_bridge
+from bench_bridge import CPUS, ONLY, PROFILES, bench_bridge
 from bench_graph import (
     GRAPH_ARGS,
     bench_lockstep,
@@ -107,12 +107,20 @@ def parser() -> argparse.ArgumentParser:
         help="run the bridge benchmark's driver and loop under taskset -c LIST (CPU numbers, "
         "comma-separated, e.g. 1)",
     )
+    p.add_argument(
+        "--profiles",
+        metavar="LIST",
+        help="run only these of the bridge benchmark's profiles (comma-separated: "
+        + ", ".join(PROFILES)
+        + ")",
+    )
     return p
 
 
 def apply(a: argparse.Namespace) -> None:
     """Set the graph benchmarks' ``GRAPH_ARGS`` and the bridge's ``CPUS`` from ``a``."""
     CPUS[:] = [a.cpus] if a.cpus else []
+    ONLY[:] = a.profiles.split(",") if a.profiles else []
     GRAPH_ARGS[:] = [x for item in a.set for x in ("--set", item)]
     if a.rt_priority is not None:
         GRAPH_ARGS.extend(["--rt-priority", str(a.rt_priority)])
@@ -135,6 +143,8 @@ def main(argv: list[str] | None = None) -> int:
             a.cpus = ",".join(map(str, checked_cpus(numbers)))
         except ValueError as exc:  # a CPU this process may not use
             p.error(f"--cpus {a.cpus}: {str(exc).removeprefix('cpu_affinity: ')}")
+    if a.profiles and any(x not in PROFILES for x in a.profiles.split(",")):
+        p.error(f"--profiles {a.profiles}: profiles are {', '.join(PROFILES)}")
     apply(a)
     unknown = [n for n in a.names if n not in BENCHMARKS]
     if unknown:

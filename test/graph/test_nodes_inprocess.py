@@ -285,6 +285,50 @@ def test_composed_in_ol_the_command_goes_out_before_the_observer_works(monkeypat
         rclpy.try_shutdown(context=ctx)
 
 
+def test_composed_in_dob_the_observers_dynamics_are_made_after_the_command(monkeypatch) -> None:
+    """DOB on the Touch's URDF, composed: estimate k goes to the controller, command k goes out,
+    and only then does the observer make the dynamics (``D`` and the bias effort) at sample k,
+    which its next update needs (``DisturbanceObserver.prepare``)."""
+    from rclpy.node import Node
+
+    from haptic_msgs_py import codecs
+    from haptic_msgs_py.bus import bus_for
+    from haptic_msgs_py.ros import qos
+    from haptic_msgs_py.ros.loop_io import LoopPublisher
+    from haptic_msgs_py.topics import EFFORT_COMMAND, JOINT_STATES, WRENCH_DESIRED, WRENCH_ESTIMATE
+
+    monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
+    urdf = Path(__file__).resolve().parents[2] / "config" / "urdf" / "phantom_omni.urdf"
+    ctx = Context()
+    params = ("model:=urdf", f"urdf_path:={urdf}", "tip_frame:=tip", "mode:=DOB")
+    rclpy.init(context=ctx, args=["--ros-args", *(x for p in params for x in ("-p", p))])
+    obs, ctl = ObserverNode(context=ctx), ControllerNode(context=ctx)
+    device = Node("device", context=ctx)
+    log: list[tuple[str, int]] = []
+    dynamics = obs.observer._dynamics
+    obs.observer._dynamics = lambda q, qd: (
+        log.append(("dynamics", obs._last_ns)),
+        dynamics(q, qd),
+    )[1]
+    bus = bus_for(ctx)
+    for topic in (EFFORT_COMMAND, WRENCH_ESTIMATE):
+        bus.add_subscriber(f"/{topic}", lambda v, t=topic: log.append((t, v.stamp_ns)), lambda: 0)
+    p_js = LoopPublisher(device, JOINT_STATES, codecs.JOINT_STATE, qos.LOOP, "world")
+    p_wall = LoopPublisher(device, WRENCH_DESIRED, codecs.WRENCH, qos.LOOP, "world")
+    names = tuple(obs.model.joint_names)
+    try:
+        stamps = [k * ctl.period_ns for k in range(1, 4)]
+        for stamp in stamps:
+            p_wall.publish(StampedVector(stamp, (0.0, 0.0, 0.5)))
+            p_js.publish(JointSample(stamp, names, (0.0, 0.3, 0.2), (0.0,) * 3, (0.0,) * 3))
+        cycle = [EFFORT_COMMAND, WRENCH_ESTIMATE, "dynamics"]
+        assert log == [(t, s) for s in stamps for t in cycle]
+    finally:
+        for n in (device, ctl, obs):
+            n.destroy_node()
+        rclpy.try_shutdown(context=ctx)
+
+
 @pytest.mark.parametrize("passivity", [False, True])
 def test_composed_the_slaves_command_goes_out_before_its_estimate_is_made(
     monkeypatch, passivity: bool

@@ -52,10 +52,14 @@ class CommandMap:
         self.unsent = tuple(j for j, s in zip(driver_joints, self.slot, strict=True) if s is None)
         self.size = len(names)
 
-    def forward(self, tau: Sequence[float], q: Sequence[float]) -> tuple[float, ...]:
-        """The driver's command elements (SI) for model efforts ``tau`` at joint positions ``q``."""
+    def forward(
+        self, tau: Sequence[float], q: Sequence[float], J: NDArray[np.float64] | None = None
+    ) -> tuple[float, ...]:
+        """The driver's command elements (SI) for model efforts ``tau`` at joint positions ``q``
+        (``J``: the tip's Jacobian there, when known)."""
         if self.cartesian:
-            J = self.model._jacobian(np.asarray(q, dtype=np.float64))
+            if J is None:
+                J = self.model._jacobian(np.asarray(q, dtype=np.float64))
             F = tip_force(J, np.asarray(tau, dtype=np.float64), DLS_THRESHOLD_M, DLS_DAMPING_M)
             out = [0.0, 0.0, 0.0]
             for i, (a, s) in enumerate(zip(self.axes, self.axis_signs, strict=True)):

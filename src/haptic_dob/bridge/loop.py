@@ -197,7 +197,9 @@ class BridgeLoop:
         if not self.deadman_held:
             self.gated += 1
             return None
-        u = self.limiter.limit(self.map.forward(tau, self._newest_q))
+        q, J = self._prev  # the Jacobian made for the newest state's sample, if it was
+        J = J if q is self._newest_q else None
+        u = self.limiter.limit(self.map.forward(tau, self._newest_q, J))
         if not all(map(math.isfinite, u)):  # a singular map, say: never sent
             self.refused += 1
             return self._zero(stamp, "the command mapped to NaN/inf", now)

@@ -148,6 +148,7 @@ class ObserverNode(LoopNode):
         self._bad_input_logged = ""
         self._force = estimate(self.observer, q, qd, tau)
         self._publish(now)  # the estimate first, then what is said of it
+        self.observer.prepare()  # the next update's dynamics, off the next command's path
         self.diagnostics.tick()
         if jump > 1:
             self.gaps += 1

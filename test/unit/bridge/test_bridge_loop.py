@@ -330,3 +330,24 @@ def test_a_command_is_counted_after_its_send_not_before() -> None:
     b.on_state(state(3), 0.0026)  # the next state books it, against state 2's deadline
     assert timing(b) == (1, 1) and b.timing.latency.n == 2
     assert b.counts()["latency_p99_ms"] == pytest.approx(1.501, abs=2e-3)
+
+
+def test_a_force_command_takes_the_jacobian_made_for_its_states_sample() -> None:
+    """On a Cartesian driver ``J^-T`` maps the command with the Jacobian made for the newest
+    state's sample: the command's path makes none of its own."""
+    driver = DriverSettings.of(
+        {"profile": "cartesian_wrench", "state.topic": "s", "command.topic": "c"}
+    )
+    s = SafetySettings(**{"command_limits": [5.0], "rate_limit": [0.0]})  # type: ignore[arg-type]
+    m, made = model(), []
+    jacobian = m._jacobian
+    m._jacobian = lambda q: (made.append(tuple(q)), jacobian(q))[1]  # type: ignore[method-assign]
+    b = BridgeLoop(driver, s.check(), m, FD, 1000.0)
+    b.start()
+    made.clear()
+    b.on_state(state(1, 0.01), 0.0)
+    assert (0.01, 0.0, 0.0) in made  # the sample's (ee_twist)
+    made.clear()
+    send = b.on_command(cmd(1, 2.0, -1.0, 0.5), 0.0002)
+    assert send is not None and send.values == pytest.approx((2.0, -1.0, 0.5))
+    assert made == []

@@ -7,12 +7,15 @@ import math
 import numpy as np
 import pytest
 
-from haptic_dob.core.models import DeviceModel, SlideModel, SlideParams
+from haptic_dob.core.models import DeviceModel, SlideModel, SlideParams, UrdfModel
 from haptic_dob.core.observers.disturbance import DisturbanceObserver
 from haptic_dob.core.tip_force import dls_transpose_solve
 from haptic_sim.hand import HandParams
 from haptic_sim.slide.device import SimulatedSlide
 from haptic_sim.slide.plant import SlideDeviceParams
+from support.paths import ROOT
+
+OMNI_URDF = ROOT / "config" / "urdf" / "phantom_omni.urdf"
 
 
 def constant_force_run(gain: float, force_n: float = 1.0, t_on: float = 0.1, drive=None):
@@ -278,6 +281,7 @@ def test_retune_keeps_the_estimate_and_takes_the_new_gain(generic: bool) -> None
     obs.update([0.0], [0.2], [0.0])
     for _ in range(50):
         before = obs.update([0.0], [0.2], [-1.0])[0]
+    obs.prepare()  # the next step's matrices made for the old gain: the retune makes them again
     obs.retune(40.0, limit=3.0)
     assert obs.gain == 40.0 and obs.limit.tolist() == [3.0]
     after = obs.update([0.0], [0.2], [-1.0])[0]
@@ -286,3 +290,60 @@ def test_retune_keeps_the_estimate_and_takes_the_new_gain(generic: bool) -> None
     assert after == pytest.approx(alpha * before + (1 - alpha) * (h + 1.0), rel=1e-12)
     with pytest.raises(ValueError, match="gain"):
         obs.retune(0.0)
+
+
+def _omni_samples(n: int, seed: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Random Touch-like samples (rad, rad/s, N m) about a posture inside its workspace."""
+    rng = np.random.default_rng(seed)
+    return [
+        (
+            np.array([0.0, 0.3, 0.2]) + 0.2 * rng.standard_normal(3),
+            rng.standard_normal(3),
+            0.05 * rng.standard_normal(3),
+        )
+        for _ in range(n)
+    ]
+
+
+def test_prepared_once_the_command_is_out_the_update_is_the_same_and_makes_no_dynamics() -> None:
+    """``prepare()`` makes the next update's dynamics: an observer prepared after every update
+    gives the very same estimates as one left to make them inside ``update``, and its updates
+    (the command's path) make no dynamics at all."""
+    model = UrdfModel(OMNI_URDF, "tip")
+    lazy, prepared = DisturbanceObserver(model, 0.5, 2e-3), DisturbanceObserver(model, 0.5, 2e-3)
+    made: list[str] = []
+    dynamics = prepared._dynamics
+    prepared._dynamics = lambda q, qd: (made.append("made"), dynamics(q, qd))[1]
+    for q, qd, tau in _omni_samples(200, 5):
+        a = lazy.update(q, qd, tau)
+        b = prepared.update(q, qd, tau)
+        assert not made  # the path made none
+        prepared.prepare()
+        assert made == ["made"]
+        made.clear()
+        assert np.array_equal(a, b)
+    prepared.prepare()
+    assert not made  # nothing pending: prepare once per sample
+
+
+def test_the_step_matrices_give_the_implicit_update() -> None:
+    """Identity between algorithms: ``z_{k+1} = P z_k + Q r`` against solving
+    ``(D_k + T c I) z_{k+1} = D_k z_k + T c r`` at every sample (the module's equation)."""
+    model = UrdfModel(OMNI_URDF, "tip")
+    c, T = 0.5, 2e-3
+    obs = DisturbanceObserver(model, c, T)
+    z, D_prev, h_prev, f_prev = None, None, None, None
+    for q, qd, tau in _omni_samples(300, 6):
+        d = obs.update(q, qd, tau)
+        D, h = model._mass_and_bias(q, qd)
+        f = model._friction(qd)
+        if z is None:
+            z, ref = -c * qd, np.zeros(3)
+        else:
+            bias = h_prev + 0.5 * (f - f_prev)
+            z = np.linalg.solve(
+                D_prev + T * c * np.eye(3), D_prev @ z + T * c * (bias - tau - c * qd)
+            )
+            ref = z + c * qd
+        D_prev, h_prev, f_prev = D, h, f
+        np.testing.assert_allclose(d, ref, rtol=1e-9, atol=1e-12)

@@ -10,15 +10,14 @@ The slide (constant D = m) uses ``c_d = (m / T)(exp(c T / m) - 1)`` for c, so it
 time constant is exactly m/c, and ``f_k = friction_k``. Other models take
 ``f_k = (friction_k + friction_{k+1}) / 2``, unless ``_has_friction`` is False (then the friction
 is in the bias effort, at sample k). ``update(q, qd, tau)`` takes sample k+1 and the effort applied
-over [k, k+1); the first call after construction or ``reset()`` only initialises (estimate 0).
-Why this form, the gain and the friction's mean: docs/design/observer.md.
+over [k, k+1) (the first call only initialises: estimate 0); ``prepare()`` makes ``D_k`` and the
+bias off the command's path. Why this form, the gain, the friction: docs/design/observer.md.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -103,6 +102,7 @@ class DisturbanceObserver:
         else:
             self.discrete_gain = self.gain
         self._tc_eye = (self.dt * self.gain) * self._eye
+        self._step: tuple[Mat, Mat] | None = None  # made again for the new gain
 
     def retune(self, gain: float, limit: float | ArrayLike | None = None) -> None:
         """Change gain and output clip while running, keeping the current estimate (no jump).
@@ -133,6 +133,8 @@ class DisturbanceObserver:
         self._qd_last: Vec = np.zeros(n)
         self._f_prev: Vec = np.zeros(n)
         self._estimate = np.zeros(n)
+        self._pending: tuple[Vec, Vec] | None = None  # the sample whose dynamics are not made
+        self._step = None
 
     @property
     def initialised(self) -> bool:
@@ -152,23 +154,41 @@ class DisturbanceObserver:
         if self._scalar:
             return self._update_scalar(q, qd, tau)
         q_, qd_, tau_ = self._sample(q, qd, tau)
-        c, T = self.gain, self.dt
-        D, h = self._dynamics(q_, qd_)
+        c = self.gain
         f = self.model._friction(qd_) if self._with_friction else None
         if self._initialised:
+            self.prepare()  # nothing to do when the caller prepared once the last command was out
+            P, Q = self._step or self._make_step()
             # the friction's impulse over the period from both its ends (trapezoid)
             bias = self._h_prev if f is None else self._h_prev + 0.5 * (f - self._f_prev)
-            rhs = self._D_prev @ self._z + (T * c) * (bias - tau_ - c * qd_)
-            self._z = cast(Vec, np.linalg.solve(self._D_prev + self._tc_eye, rhs))
+            self._z = P @ self._z + Q @ (bias - tau_ - c * qd_)
             d = self._z + c * qd_
         else:
             self._z = -c * qd_
             d = np.zeros(self._n)
             self._initialised = True
-        self._D_prev, self._h_prev = D, h
+        self._pending = (q_, qd_)
         if f is not None:
             self._f_prev = f
         return self._output(d, qd_)
+
+    def prepare(self) -> None:
+        """Make the next update's dynamics (``D`` and the bias effort of the last sample) and its
+        implicit step's matrices. Call it once the command is out, to keep that work off the next
+        command's path; ``update`` does it first otherwise, with the same result."""
+        if self._pending is None:
+            return
+        q, qd = self._pending
+        self._pending = None
+        self._D_prev, self._h_prev = self._dynamics(q, qd)
+        self._make_step()
+
+    def _make_step(self) -> tuple[Mat, Mat]:
+        """``z_{k+1} = P z_k + Q r``: ``P = A^-1 D_k``, ``Q = T c A^-1``, ``A = D_k + T c I``."""
+        A_inv: Mat = np.linalg.inv(self._D_prev + self._tc_eye).astype(np.float64, copy=False)
+        step: tuple[Mat, Mat] = (A_inv @ self._D_prev, (self.dt * self.gain) * A_inv)
+        self._step = step
+        return step
 
     def _output(self, d: Vec, qd: Vec) -> Vec:
         """Keep sample's ``q'``, clip ``d`` to ``limit``, hold it as the estimate; a copy."""
