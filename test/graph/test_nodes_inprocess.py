@@ -16,6 +16,7 @@ from haptic_dob.nodes.controller_node import ControllerNode
 from haptic_dob.nodes.environment_node import EnvironmentNode
 from haptic_dob.nodes.observer_node import ObserverNode
 from haptic_dob.nodes.slave_controller_node import SlaveControllerNode
+from haptic_msgs_py.topics import EFFORT_COMMAND, WRENCH_ESTIMATE
 from haptic_msgs_py.values import EffortCommand, JointSample, StampedVector
 from haptic_sim.nodes.device_node import DeviceNode
 from support.rosgraph import isolated_env
@@ -245,62 +246,23 @@ def test_after_a_switch_the_controller_waits_for_a_lagging_input(context) -> Non
         ctl.destroy_node()
 
 
-def test_composed_in_ol_the_command_goes_out_before_the_observer_works(monkeypatch) -> None:
-    """On a device whose Jacobian depends on q (the Touch's URDF) the controller takes the joint
-    states, and so does the observer, whose estimate OL does not use: composed, command k is out
-    before estimate k is made, though the observer joined the process first (as the registry
-    builds them)."""
+def _touch_cycles(monkeypatch, mode: str) -> tuple[list[tuple[str, int]], list[int], bool]:
+    """Three samples of the Touch's URDF through the observer and the controller composed in
+    ``mode`` (the observer built first, as the registry builds them): what happened in order by
+    stamp (the command, the estimate, the observer making its dynamics), the stamps, and
+    whether the controller takes the joint states."""
     from rclpy.node import Node
 
     from haptic_msgs_py import codecs
     from haptic_msgs_py.bus import bus_for
     from haptic_msgs_py.ros import qos
     from haptic_msgs_py.ros.loop_io import LoopPublisher
-    from haptic_msgs_py.topics import EFFORT_COMMAND, JOINT_STATES, WRENCH_DESIRED, WRENCH_ESTIMATE
+    from haptic_msgs_py.topics import JOINT_STATES, WRENCH_DESIRED
 
     monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
     urdf = Path(__file__).resolve().parents[2] / "config" / "urdf" / "phantom_omni.urdf"
     ctx = Context()
-    params = ("model:=urdf", f"urdf_path:={urdf}", "tip_frame:=tip", "mode:=OL")
-    rclpy.init(context=ctx, args=["--ros-args", *(x for p in params for x in ("-p", p))])
-    obs, ctl = ObserverNode(context=ctx), ControllerNode(context=ctx)
-    assert ctl.join.needs_q
-    device = Node("device", context=ctx)
-    log: list[tuple[str, int]] = []
-    bus = bus_for(ctx)
-    for topic in (EFFORT_COMMAND, WRENCH_ESTIMATE):
-        bus.add_subscriber(f"/{topic}", lambda v, t=topic: log.append((t, v.stamp_ns)), lambda: 0)
-    p_js = LoopPublisher(device, JOINT_STATES, codecs.JOINT_STATE, qos.LOOP, "world")
-    p_wall = LoopPublisher(device, WRENCH_DESIRED, codecs.WRENCH, qos.LOOP, "world")
-    names = tuple(obs.model.joint_names)
-    try:
-        stamps = [k * ctl.period_ns for k in range(1, 4)]
-        for stamp in stamps:
-            p_wall.publish(StampedVector(stamp, (0.0, 0.0, 0.5)))
-            p_js.publish(JointSample(stamp, names, (0.0, 0.3, 0.2), (0.0,) * 3, (0.0,) * 3))
-        assert log == [x for s in stamps for x in ((EFFORT_COMMAND, s), (WRENCH_ESTIMATE, s))]
-    finally:
-        for n in (device, ctl, obs):
-            n.destroy_node()
-        rclpy.try_shutdown(context=ctx)
-
-
-def test_composed_in_dob_the_observers_dynamics_are_made_after_the_command(monkeypatch) -> None:
-    """DOB on the Touch's URDF, composed: estimate k goes to the controller, command k goes out,
-    and only then does the observer make the dynamics (``D`` and the bias effort) at sample k,
-    which its next update needs (``DisturbanceObserver.prepare``)."""
-    from rclpy.node import Node
-
-    from haptic_msgs_py import codecs
-    from haptic_msgs_py.bus import bus_for
-    from haptic_msgs_py.ros import qos
-    from haptic_msgs_py.ros.loop_io import LoopPublisher
-    from haptic_msgs_py.topics import EFFORT_COMMAND, JOINT_STATES, WRENCH_DESIRED, WRENCH_ESTIMATE
-
-    monkeypatch.setenv("ROS_DOMAIN_ID", isolated_env()["ROS_DOMAIN_ID"])
-    urdf = Path(__file__).resolve().parents[2] / "config" / "urdf" / "phantom_omni.urdf"
-    ctx = Context()
-    params = ("model:=urdf", f"urdf_path:={urdf}", "tip_frame:=tip", "mode:=DOB")
+    params = ("model:=urdf", f"urdf_path:={urdf}", "tip_frame:=tip", f"mode:={mode}")
     rclpy.init(context=ctx, args=["--ros-args", *(x for p in params for x in ("-p", p))])
     obs, ctl = ObserverNode(context=ctx), ControllerNode(context=ctx)
     device = Node("device", context=ctx)
@@ -321,12 +283,25 @@ def test_composed_in_dob_the_observers_dynamics_are_made_after_the_command(monke
         for stamp in stamps:
             p_wall.publish(StampedVector(stamp, (0.0, 0.0, 0.5)))
             p_js.publish(JointSample(stamp, names, (0.0, 0.3, 0.2), (0.0,) * 3, (0.0,) * 3))
-        cycle = [EFFORT_COMMAND, WRENCH_ESTIMATE, "dynamics"]
-        assert log == [(t, s) for s in stamps for t in cycle]
+        return log, stamps, ctl.join.needs_q
     finally:
         for n in (device, ctl, obs):
             n.destroy_node()
         rclpy.try_shutdown(context=ctx)
+
+
+@pytest.mark.parametrize("mode", ["OL", "DOB"])
+def test_composed_the_command_goes_out_before_the_observer_makes_its_dynamics(
+    monkeypatch, mode: str
+) -> None:
+    """The Touch's URDF, composed. OL: its Jacobian depends on q, so the controller takes the
+    joint states, and so does the observer, whose estimate OL does not use: command k is out
+    before estimate k is made, though the observer joined the process first. DOB: estimate k
+    goes to the controller and command k out; in either, only then does the observer make the
+    dynamics at sample k that its next update needs (``DisturbanceObserver.prepare``)."""
+    log, stamps, needs_q = _touch_cycles(monkeypatch, mode)
+    assert needs_q
+    assert log == [(t, s) for s in stamps for t in (EFFORT_COMMAND, WRENCH_ESTIMATE, "dynamics")]
 
 
 @pytest.mark.parametrize("passivity", [False, True])
