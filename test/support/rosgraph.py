@@ -58,6 +58,19 @@ def isolated_env(domain: int | None = None) -> dict[str, str]:
     return env
 
 
+def descendants(pid: int) -> list[int]:
+    """The processes ``pid`` started, and theirs, while they live (``/proc``'s children lists)."""
+    found: list[int] = []
+    todo = [pid]
+    while todo:
+        for children in Path(f"/proc/{todo.pop()}/task").glob("*/children"):
+            with contextlib.suppress(OSError):
+                kids = [int(x) for x in children.read_text().split()]
+                found += kids
+                todo += kids
+    return found
+
+
 class Process:
     """A child process in its own session, stopped with SIGINT then killed if it lingers."""
 
@@ -73,7 +86,9 @@ class Process:
         return self.proc.wait(timeout)
 
     def stop(self, timeout: float = 10.0) -> int | None:
-        """SIGINT the process group, wait, then SIGKILL it."""
+        """SIGINT the process group, wait, then SIGKILL it and every process it started (a
+        launch starts its nodes in sessions of their own: under SCHED_FIFO a stuck node can keep
+        the launch itself from ever running, and would outlive the test)."""
         if self.proc.poll() is None:
             try:
                 os.killpg(self.proc.pid, signal.SIGINT)
@@ -81,9 +96,12 @@ class Process:
             except (subprocess.TimeoutExpired, ProcessLookupError):
                 pass
         if self.proc.poll() is None:
+            for pid in descendants(self.proc.pid):  # by id: what this process started
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(pid, signal.SIGKILL)
             with contextlib.suppress(ProcessLookupError):
                 os.killpg(self.proc.pid, signal.SIGKILL)
-            self.proc.wait(5)
+            self.proc.wait(30)
         if self._log is not subprocess.DEVNULL:
             self._log.close()
         return self.proc.returncode
