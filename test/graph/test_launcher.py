@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import signal
 import subprocess
 import time
@@ -232,9 +233,13 @@ def test_rt_priority_without_permission_is_one_line(monkeypatch) -> None:
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="SCHED_FIFO needs root here")
 def test_rt_priority_runs_the_nodes_under_sched_fifo(root, tmp_path) -> None:
-    out = launch_cli("slide_sim", "--rt-priority", "10", "--set", "device_node:duration_s=0.5")
+    """The loop's nodes under SCHED_FIFO; a recorder, off the command's path, at normal
+    scheduling (at the loop's priority it held a CPU from the driver)."""
+    args = ["--rt-priority", "10", "--record", str(tmp_path / "bag")]
+    out = launch_cli("slide_sim", *args, "--set", "device_node:duration_s=0.5")
     assert out.returncode == 0, out.stderr
     assert "scheduling SCHED_FIFO priority 10" in out.stderr
+    assert re.search(r"recording \d+ topic\(s\) to .*, scheduling normal", out.stderr), out.stderr
 
 
 def _affinity_of_every_thread(pid: int) -> set[int]:

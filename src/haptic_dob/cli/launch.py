@@ -175,7 +175,8 @@ def build_parser() -> ArgumentParser:
         type=int,
         metavar="P",
         help="run the nodes with real-time scheduling, SCHED_FIFO priority P (1-99; Linux, needs "
-        "root or CAP_SYS_NICE): fewer late commands in real time (BENCHMARKS.md)",
+        "root or CAP_SYS_NICE): fewer late commands in real time (BENCHMARKS.md); a recorder "
+        "alone in its process stays at normal scheduling",
     )
     p.add_argument(
         "--pin",

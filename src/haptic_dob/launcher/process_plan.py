@@ -12,7 +12,7 @@ from typing import Any
 from ament_index_python.packages import PackageNotFoundError, get_package_prefix
 
 from haptic_dob.errors import InputError
-from haptic_dob.nodes.registry import CONTAINER, LOOP_NODES, NODES, START_ORDER
+from haptic_dob.nodes.registry import CONTAINER, LOOP_NODES, NODES, OFF_PATH_NODES, START_ORDER
 from haptic_msgs_py.ament import ensure_ament_prefix
 
 
@@ -32,6 +32,12 @@ class ProcessSpec:
     def label(self) -> str:
         """How messages name the process."""
         return self.name if len(self.nodes) == 1 else f"the process of {self.name}"
+
+    @property
+    def off_path(self) -> bool:
+        """Every node of the process is off the command's path (``OFF_PATH_NODES``; a teleop's
+        namespaced names by their last part)."""
+        return all(n.rsplit("/", 1)[-1] in OFF_PATH_NODES for n in self.nodes)
 
 
 def executable(package: str, name: str) -> str:

@@ -5,12 +5,13 @@ and stop them all (the device's first), killing what outlives the stop timeout."
 
 from __future__ import annotations
 
+import functools
 import os
 import signal
 import subprocess
 import sys
 import time
-from collections.abc import Collection
+from collections.abc import Callable, Collection
 
 from haptic_dob.errors import InputError
 from haptic_dob.launcher.process_plan import ProcessSpec
@@ -37,6 +38,17 @@ def set_rt_priority(priority: int) -> None:
             f"--rt-priority {priority}: not permitted ({exc.strerror}); it needs root, "
             "CAP_SYS_NICE, or an rtprio limit (limits.conf) of at least that priority"
         ) from None
+
+
+def off_path_scheduling() -> Callable[[], None] | None:
+    """What a process off the command's path runs before its program starts, when this process
+    runs under ``SCHED_FIFO`` (``--rt-priority``, which node processes inherit): back to normal
+    scheduling. At the loop's priority such a process (a recorder writing its bag) held a CPU
+    from the driver and the loop for milliseconds at a time. None otherwise."""
+    if not hasattr(os, "sched_getscheduler") or os.sched_getscheduler(0) != os.SCHED_FIFO:
+        return None
+    # made here: the child only makes the call (a preexec_fn runs between fork and exec)
+    return functools.partial(os.sched_setscheduler, 0, os.SCHED_OTHER, os.sched_param(0))
 
 
 def check_cpu_latency_request(latency_us: int) -> None:
@@ -75,12 +87,14 @@ def launch(
         if any(n.rsplit("/", 1)[-1] in RUN_ENDS and n not in endless for n in s.nodes)
     }
     code = 0
+    normal = off_path_scheduling()
     try:
         for spec in specs:
             procs[spec.name] = subprocess.Popen(
                 [spec.executable, *spec.args],
                 start_new_session=True,
                 env={**os.environ, **(env or {})},
+                preexec_fn=normal if spec.off_path else None,
             )
         t_end = None if duration is None else time.monotonic() + duration
         while not stop:

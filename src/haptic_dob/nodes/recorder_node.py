@@ -47,6 +47,7 @@ from haptic_dob.recorder.recording import Recording
 from haptic_dob.recorder.settings import new_bag_path, progress_topic, recorder_specs
 from haptic_dob.recorder.snapshots import ParameterSnapshot, SnapshotTracker
 from haptic_dob.recorder.topics import TopicKind, parse_topics
+from haptic_dob.runtime.cpus import scheduling
 from haptic_dob.runtime.ros.spin import LoopNode
 from haptic_msgs_py.ros import qos
 from haptic_msgs_py.ros.raw import rclpy_type
@@ -123,7 +124,8 @@ class RecorderNode(LoopNode):
         ]
         self.create_timer(1.0 / v["progress_rate_hz"], self._publish_progress)
         self.log.info(
-            f"recording {len(topics)} topic(s) to {self.recording.path} ({self.recording.storage})"
+            f"recording {len(topics)} topic(s) to {self.recording.path} "
+            f"({self.recording.storage}), scheduling {scheduling()}"
         )
 
     def _offered_qos(self, topic: str) -> list[Qos]:

@@ -56,6 +56,11 @@ NODES: dict[str, NodeEntry] = _registered()
 #: foreign driver's bridge takes the simulated device's place (the driver is its own process)
 LOOP_NODES = ("device_node", "bridge_node", "environment_node", "observer_node", "controller_node")
 
+#: nodes off the command's path: a process of these alone keeps normal scheduling under
+#: ``haptic-launch --rt-priority`` (at the loop's priority a recorder's bursts held a CPU from
+#: the driver and the loop, docs/running.md)
+OFF_PATH_NODES = ("recorder_node",)
+
 #: the executable that hosts several nodes in one process (``ros2 run haptic_dob container``)
 CONTAINER = ("haptic_dob", "container")
 

@@ -35,6 +35,7 @@ def test_the_loop_shares_a_process_by_default_and_a_recorder_runs_apart(root, tm
     names = [n for n in params if n != "/**"]
     specs = plan(params, tmp_path / "p.yaml", "/ns", groups_for(names, False, False, ()))
     assert [s.nodes for s in specs] == [["recorder_node"], LOOP]
+    assert [s.off_path for s in specs] == [True, False]  # the recorder leaves --rt-priority
     station = specs[1]
     assert Path(station.executable).parts[-3:] == ("lib", "haptic_dob", "container")
     assert station.args[:4] == LOOP and "__ns:=/ns" in station.args
@@ -52,6 +53,7 @@ def test_the_loop_shares_a_process_by_default_and_a_recorder_runs_apart(root, tm
     ]
     everything = plan(params, tmp_path / "p.yaml", "", groups_for(names, True, False, ()))
     assert [s.nodes for s in everything] == [ALL]
+    assert not everything[0].off_path  # a recorder sharing the loop's process runs as the loop
 
 
 def test_a_node_alone_runs_its_own_executable_with_the_params_file(tmp_path) -> None:

@@ -158,6 +158,7 @@ def test_record_adds_a_recorder_of_both_sides_apart_that_both_devices_wait_for(
     for composed, processes in ((False, False), (True, False), (False, True)):
         plan = teleop_plan(params, path, teleop_groups(names, composed, processes, ()))
         assert plan[0].nodes == ["recorder_node"]  # first, alone, in the root namespace
+        assert [s.off_path for s in plan] == [True] + [False] * (len(plan) - 1)
         assert plan[0].executable.endswith("recorder_node") and "__ns:=" not in plan[0].args
         assert all("recorder_node" not in s.nodes for s in plan[1:])
     with pytest.raises(InputError, match="exists already"):
