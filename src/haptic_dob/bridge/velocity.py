@@ -23,6 +23,10 @@ from typing import Protocol
 from haptic_dob.core.kalman_velocity import KalmanState, steady_gain
 from haptic_msgs_py.stamps import NS_PER_S
 
+#: a step under this share of half a count is the driver's floating-point rounding (a joint
+#: it computes from two others), not a finer encoder's count: ``finer_steps`` ignores it
+ROUNDING_SHARE = 1e-6
+
 
 class Velocity(Protocol):
     """What the state reader asks of a velocity estimator."""
@@ -104,7 +108,10 @@ class WindowVelocity:
         new: dict[int, float] = {}
         if len(self._q) >= 2:
             for j, (a, b) in enumerate(zip(self._q[0], self._q[1], strict=True)):
-                if 0.0 < abs(a - b) < self.half[j] and j not in self._finer:
+                if (
+                    ROUNDING_SHARE * self.half[j] < abs(a - b) < self.half[j]
+                    and j not in self._finer
+                ):
                     self._finer.add(j)
                     new[j] = abs(a - b)
         return new
@@ -164,7 +171,7 @@ class KalmanVelocity:
         step (called off the command's path): a count set too coarse over-smooths."""
         new: dict[int, float] = {}
         for j, (a, b) in enumerate(zip(self._q, self._prev, strict=False)):
-            if 0.0 < abs(a - b) < self.half[j] and j not in self._finer:
+            if ROUNDING_SHARE * self.half[j] < abs(a - b) < self.half[j] and j not in self._finer:
                 self._finer.add(j)
                 new[j] = abs(a - b)
         return new

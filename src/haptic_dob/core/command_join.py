@@ -97,6 +97,7 @@ class CommandJoin:
         self.estimated_in = ForceInput()
         self.sent_ns = -1  # stamp of the newest command computed
         self.newest_ns = -1  # stamp of the newest cycle an input opened
+        self.first_ns = -1  # stamp of the first cycle: an input never received is silent since
         self.fallback_reason: str | None = None
         self.fallbacks = 0
         # after a switch to a mode with a force input: wait while that input, still flowing,
@@ -137,16 +138,22 @@ class CommandJoin:
     def wall(self, stamp: int, force: Force) -> list[float] | None:
         """The wall force of sample ``stamp`` (a cycle-defining input)."""
         if stamp > self.newest_ns:
-            self.newest_ns = stamp
+            self._open(stamp)
         self.desired.take(stamp, force)
         return self._decide()
 
     def joints(self, stamp: int, q: Sequence[float]) -> list[float] | None:
         """The joint positions of sample ``stamp`` (a cycle-defining input when J depends on q)."""
         if stamp > self.newest_ns:
-            self.newest_ns = stamp
+            self._open(stamp)
         self.joints_in.take(stamp, q)
         return self._decide()
+
+    def _open(self, stamp: int) -> None:
+        """Sample ``stamp`` opens the newest cycle."""
+        if self.first_ns < 0:
+            self.first_ns = stamp
+        self.newest_ns = stamp
 
     def measured(self, stamp: int, force: Force) -> list[float] | None:
         """The force sensor's hand force of sample ``stamp``."""
@@ -196,11 +203,13 @@ class CommandJoin:
                     self.fallback_reason = None
                     self._info(f"{topic} flows again: back to {self.mode_text()}")
             elif not self.fallback_reason:
-                if k - src.stamp <= self.input_timeout_ns:
+                since = src.stamp if src.stamp >= 0 else self.first_ns
+                if k - since <= self.input_timeout_ns:
                     return None  # on its way: wait for it
                 if self.catching_up and src.flowing(k, self.period_ns):
                     return None  # lagging behind after a switch, but coming: wait for it
-                self._fall_back(f"{topic} silent for {(k - src.stamp) * 1e-6:.0f} ms of samples")
+                silent = "silent for" if src.stamp >= 0 else "not received in the first"
+                self._fall_back(f"{topic} {silent} {(k - since) * 1e-6:.0f} ms of samples")
         if k != self.sent_ns:
             if self.fallback_reason is None:
                 self._command = self.controller.command(

@@ -202,6 +202,21 @@ def test_a_count_set_too_coarse_is_said_once_per_joint() -> None:
     assert reader(encoder_resolution=[0.0]).count_warnings() == []
 
 
+def test_a_step_of_floating_point_rounding_is_no_count() -> None:
+    """A driver that computes a joint from two others (a Touch's elbow) steps it by rounding
+    now and then, 5.55e-17 rad between equal counts: said nothing (it once was)."""
+    count = 8e-4
+    a, b = 0.1 + 0.2, 0.3  # equal in counts, apart in the last bit
+    assert a != b
+    for kalman in ({}, {"velocity_jerk_psd": [800.0]}):  # the window, the Kalman filter
+        r = reader(joints=["a", "b", "c"], encoder_resolution=[count], **kalman)
+        lines = []
+        for k, q in enumerate([a, b, a, b + count]):
+            r.joints(k * T_NS, ("a", "b", "c"), [q, 0.0, 0.0], [], [])
+            lines += r.count_warnings()
+        assert lines == [], lines
+
+
 def test_with_the_kalman_filter_a_count_set_too_coarse_is_said_too() -> None:
     """The filter takes the count as its noise: a joint stepping under half of it is named
     once, as with the window."""

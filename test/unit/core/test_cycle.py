@@ -92,6 +92,24 @@ def test_a_silent_input_falls_back_and_flowing_again_returns(fallback, expected)
     assert j.fallback_reason is None and out == [-1.5] and told
 
 
+def test_an_input_not_received_yet_is_waited_for_from_the_first_cycle() -> None:
+    """Stamps of a driver's clock (ns since 1970): the first estimate is on its way, not silent
+    since time zero (it once fell back at the first sample, "silent for 1795934945722 ms")."""
+    warned: list[str] = []
+    j = join("DOB", input_timeout_ns=5 * T, warn=warned.append)
+    t0 = 1_795_934_945_722_000_000
+    assert j.wall(t0, f(-1.0)) is None  # waits for the estimate of this sample
+    assert j.estimated(t0, f(0.5)) == [-1.5] and j.fallbacks == 0
+    j = join("DOB", input_timeout_ns=5 * T, warn=warned.append)
+    for k in range(6):
+        assert j.wall(t0 + k * T, f(-1.0)) is None
+    assert j.wall(t0 + 6 * T, f(-1.0)) == [0.0]
+    assert warned == [
+        "DOB (Kf 1) lost its input (wrench_estimate not received in the first 6 ms of samples): "
+        "rendering zero until it flows again"
+    ]
+
+
 def test_the_batch_cycle_is_the_three_stages_in_order() -> None:
     """``LoopCycle.step`` computes exactly what the stages give one by one (as the nodes do)."""
     cfg = SessionConfig()
