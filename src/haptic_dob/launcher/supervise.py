@@ -1,7 +1,8 @@
 """The launch's processes at run time: the scheduling and wake-up latency they start with, then
 start, watch (a failed node stops the graph, and so does the end of the run once every device
-finished its own; one that runs until stopped is not waited for), forward Ctrl-C and SIGTERM,
-and stop them all (the device's first), killing what outlives the stop timeout."""
+finished its own; one that runs until stopped is not waited for), forward Ctrl-C, SIGTERM and
+SIGHUP, and stop them all (the device's first), killing what outlives the stop timeout. Should
+the launcher itself die, each process gets SIGTERM (``runtime.entry.follow_launcher``)."""
 
 from __future__ import annotations
 
@@ -16,7 +17,11 @@ from collections.abc import Callable, Collection
 from haptic_dob.errors import InputError
 from haptic_dob.launcher.process_plan import ProcessSpec
 from haptic_dob.runtime.cpu_latency import hold
+from haptic_dob.runtime.entry import LAUNCHER_PID
 
+#: what stops the graph in order: Ctrl-C, SIGTERM, and the terminal closing (SIGHUP: the nodes
+#: run in sessions of their own, so only the launcher hears it)
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 RT_PRIORITIES = range(1, 100)  # SCHED_FIFO priorities Linux accepts
 #: nodes whose finished run ends the graph: a device's (lockstep) run, a bridge's duration_s
 RUN_ENDS = ("device_node", "bridge_node")
@@ -78,7 +83,7 @@ def launch(
     def on_signal(signum: int, _frame: object) -> None:
         stop.append(signum)
 
-    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    old = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
     procs: dict[str, subprocess.Popen[bytes]] = {}
     labels = {s.name: s.label for s in specs}
     devices = {
@@ -93,7 +98,7 @@ def launch(
             procs[spec.name] = subprocess.Popen(
                 [spec.executable, *spec.args],
                 start_new_session=True,
-                env={**os.environ, **(env or {})},
+                env={**os.environ, **(env or {}), LAUNCHER_PID: str(os.getpid())},
                 preexec_fn=normal if spec.off_path else None,
             )
         t_end = None if duration is None else time.monotonic() + duration
