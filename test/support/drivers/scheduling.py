@@ -18,20 +18,21 @@ from support.paths import can_request_cpu_latency
 
 
 @functools.cache
+def priority_args() -> tuple[str, ...]:
+    """``--rt-priority`` where this machine allows it now (a teleoperation's launch takes no
+    ``--cpu-latency``)."""
+    if len(os.sched_getaffinity(0)) < 2:  # on one CPU a FIFO loop would hold the driver off
+        return ()
+    probe = (
+        f"import os; os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param({DRIVER_RT_PRIORITY}))"
+    )
+    tried = subprocess.run([sys.executable, "-c", probe], capture_output=True, timeout=60)
+    return ("--rt-priority", str(DRIVER_RT_PRIORITY)) if tried.returncode == 0 else ()
+
+
 def launch_args() -> tuple[str, ...]:
     """``haptic-launch`` options of the loop's real-time set-up this machine allows now."""
-    args: list[str] = []
-    if len(os.sched_getaffinity(0)) >= 2:  # on one CPU a FIFO loop would hold the driver off
-        probe = (
-            "import os; os.sched_setscheduler(0, os.SCHED_FIFO, "
-            f"os.sched_param({DRIVER_RT_PRIORITY}))"
-        )
-        tried = subprocess.run([sys.executable, "-c", probe], capture_output=True, timeout=60)
-        if tried.returncode == 0:
-            args += ["--rt-priority", str(DRIVER_RT_PRIORITY)]
-    if can_request_cpu_latency():
-        args += ["--cpu-latency", "0"]
-    return tuple(args)
+    return priority_args() + (("--cpu-latency", "0") if can_request_cpu_latency() else ())
 
 
 def described() -> str:
