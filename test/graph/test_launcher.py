@@ -17,7 +17,7 @@ import pytest
 from haptic_msgs_py.topics import JOINT_STATES, SESSION_TOPICS
 from haptic_sim.slide.session import SessionConfig, run_session
 from support.paths import can_request_cpu_latency, tool
-from support.rosgraph import Collector, Process, isolated_env, launch
+from support.rosgraph import Collector, Process, alive, isolated_env, launch
 from support.waits import wait_until
 
 #: executable (as in a node's command line) -> node name
@@ -42,15 +42,6 @@ def running(graph: Process, log: Path) -> Callable[[], None]:
         assert graph.proc.poll() is None, log.read_text()
 
     return check
-
-
-def alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    state = subprocess.run(["ps", "-o", "stat=", "-p", str(pid)], capture_output=True, text=True)
-    return bool(state.stdout.strip()) and not state.stdout.strip().startswith("Z")
 
 
 @pytest.mark.multiprocess

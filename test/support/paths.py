@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -17,6 +18,18 @@ def tool(name: str) -> str:
     path = BIN / name
     assert path.exists(), f"{name} is not installed in {BIN}"
     return str(path)
+
+
+def can_use_fifo(priority: int) -> bool:
+    """Whether a process started now may run under ``SCHED_FIFO`` at ``priority`` (root,
+    CAP_SYS_NICE or an rtprio limit; tried in a process of its own)."""
+    if not hasattr(os, "sched_setscheduler"):
+        return False
+    probe = f"import os; os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param({priority}))"
+    return (
+        subprocess.run([sys.executable, "-c", probe], capture_output=True, timeout=60).returncode
+        == 0
+    )
 
 
 def can_request_cpu_latency() -> bool:

@@ -58,6 +58,15 @@ def isolated_env(domain: int | None = None) -> dict[str, str]:
     return env
 
 
+def alive(pid: int) -> bool:
+    """Process ``pid`` runs: not gone, and not a zombie nobody reaped yet (an orphan's exit)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (FileNotFoundError, ProcessLookupError):
+        return False
+
+
 def descendants(pid: int) -> list[int]:
     """The processes ``pid`` started, and theirs, while they live (``/proc``'s children lists)."""
     found: list[int] = []

@@ -28,6 +28,20 @@ from haptic_msgs_py.stamps import NS_PER_S
 ROUNDING_SHARE = 1e-6
 
 
+def finer_steps(
+    newest: Sequence[float], before: Sequence[float], half: Sequence[float], said: set[int]
+) -> dict[int, float]:
+    """The joints whose step from ``before`` to ``newest`` is under half their count (and over
+    rounding), each once ever (``said`` keeps them), with that step."""
+    new: dict[int, float] = {}
+    for j, (a, b) in enumerate(zip(newest, before, strict=False)):
+        step = abs(a - b)
+        if ROUNDING_SHARE * half[j] < step < half[j] and j not in said:
+            said.add(j)
+            new[j] = step
+    return new
+
+
 class Velocity(Protocol):
     """What the state reader asks of a velocity estimator."""
 
@@ -105,16 +119,9 @@ class WindowVelocity:
     def finer_steps(self) -> dict[int, float]:
         """The joints whose newest step is under half their count, each once ever, with that
         step (called off the command's path)."""
-        new: dict[int, float] = {}
-        if len(self._q) >= 2:
-            for j, (a, b) in enumerate(zip(self._q[0], self._q[1], strict=True)):
-                if (
-                    ROUNDING_SHARE * self.half[j] < abs(a - b) < self.half[j]
-                    and j not in self._finer
-                ):
-                    self._finer.add(j)
-                    new[j] = abs(a - b)
-        return new
+        if len(self._q) < 2:
+            return {}
+        return finer_steps(self._q[0], self._q[1], self.half, self._finer)
 
     def reset(self) -> None:
         """Forget the history: the next sample starts again from zero velocity."""
@@ -169,12 +176,7 @@ class KalmanVelocity:
     def finer_steps(self) -> dict[int, float]:
         """The joints whose newest step is under half their count, each once ever, with that
         step (called off the command's path): a count set too coarse over-smooths."""
-        new: dict[int, float] = {}
-        for j, (a, b) in enumerate(zip(self._q, self._prev, strict=False)):
-            if ROUNDING_SHARE * self.half[j] < abs(a - b) < self.half[j] and j not in self._finer:
-                self._finer.add(j)
-                new[j] = abs(a - b)
-        return new
+        return finer_steps(self._q, self._prev, self.half, self._finer)
 
     def reset(self) -> None:
         """Forget the state: the next sample starts again from zero velocity."""

@@ -97,7 +97,7 @@ class CommandJoin:
         self.estimated_in = ForceInput()
         self.sent_ns = -1  # stamp of the newest command computed
         self.newest_ns = -1  # stamp of the newest cycle an input opened
-        self.first_ns = -1  # stamp of the first cycle: an input never received is silent since
+        self.awaited_ns = -1  # the first cycle that waited for a force input never received
         self.fallback_reason: str | None = None
         self.fallbacks = 0
         # after a switch to a mode with a force input: wait while that input, still flowing,
@@ -138,22 +138,16 @@ class CommandJoin:
     def wall(self, stamp: int, force: Force) -> list[float] | None:
         """The wall force of sample ``stamp`` (a cycle-defining input)."""
         if stamp > self.newest_ns:
-            self._open(stamp)
+            self.newest_ns = stamp
         self.desired.take(stamp, force)
         return self._decide()
 
     def joints(self, stamp: int, q: Sequence[float]) -> list[float] | None:
         """The joint positions of sample ``stamp`` (a cycle-defining input when J depends on q)."""
         if stamp > self.newest_ns:
-            self._open(stamp)
+            self.newest_ns = stamp
         self.joints_in.take(stamp, q)
         return self._decide()
-
-    def _open(self, stamp: int) -> None:
-        """Sample ``stamp`` opens the newest cycle."""
-        if self.first_ns < 0:
-            self.first_ns = stamp
-        self.newest_ns = stamp
 
     def measured(self, stamp: int, force: Force) -> list[float] | None:
         """The force sensor's hand force of sample ``stamp``."""
@@ -203,7 +197,9 @@ class CommandJoin:
                     self.fallback_reason = None
                     self._info(f"{topic} flows again: back to {self.mode_text()}")
             elif not self.fallback_reason:
-                since = src.stamp if src.stamp >= 0 else self.first_ns
+                if src.stamp < 0 and self.awaited_ns < 0:
+                    self.awaited_ns = k  # none yet: silent from the first cycle that waits
+                since = src.stamp if src.stamp >= 0 else self.awaited_ns
                 if k - since <= self.input_timeout_ns:
                     return None  # on its way: wait for it
                 if self.catching_up and src.flowing(k, self.period_ns):

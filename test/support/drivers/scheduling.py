@@ -10,11 +10,9 @@ from __future__ import annotations
 
 import functools
 import os
-import subprocess
-import sys
 
 from support.drivers.run import DRIVER_RT_PRIORITY
-from support.paths import can_request_cpu_latency
+from support.paths import can_request_cpu_latency, can_use_fifo
 
 
 @functools.cache
@@ -23,11 +21,7 @@ def priority_args() -> tuple[str, ...]:
     ``--cpu-latency``)."""
     if len(os.sched_getaffinity(0)) < 2:  # on one CPU a FIFO loop would hold the driver off
         return ()
-    probe = (
-        f"import os; os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param({DRIVER_RT_PRIORITY}))"
-    )
-    tried = subprocess.run([sys.executable, "-c", probe], capture_output=True, timeout=60)
-    return ("--rt-priority", str(DRIVER_RT_PRIORITY)) if tried.returncode == 0 else ()
+    return ("--rt-priority", str(DRIVER_RT_PRIORITY)) if can_use_fifo(DRIVER_RT_PRIORITY) else ()
 
 
 def launch_args() -> tuple[str, ...]:

@@ -9,6 +9,8 @@ import sys
 
 import pytest
 
+from support.paths import can_use_fifo
+
 #: in a process of its own, so that this test's worker keeps its scheduling: the launch's own
 #: policy before and under SCHED_FIFO, and what a child started each way runs under
 SCRIPT = """
@@ -22,12 +24,7 @@ for start in (None, off_path_scheduling()):
 """
 
 
-def _can_fifo() -> bool:
-    probe = "import os; os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(10))"
-    return subprocess.run([sys.executable, "-c", probe], capture_output=True).returncode == 0
-
-
-@pytest.mark.skipif(not hasattr(os, "sched_setscheduler") or not _can_fifo(), reason="no FIFO")
+@pytest.mark.skipif(not can_use_fifo(10), reason="SCHED_FIFO is not allowed here")
 def test_a_process_off_the_path_leaves_the_launchs_real_time_scheduling() -> None:
     out = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr

@@ -10,6 +10,7 @@ import sys
 import pytest
 
 from haptic_dob.runtime.entry import BLAS_THREADS, LAUNCHER_PID
+from support.rosgraph import alive
 from support.waits import wait_until
 
 PROBE = """
@@ -74,15 +75,6 @@ time.sleep(60)
 """
 
 
-def _ended(pid: int) -> bool:
-    """Gone, or a zombie nobody reaped yet (an orphan's exit)."""
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            return f.read().rsplit(")", 1)[1].split()[0] == "Z"
-    except FileNotFoundError:
-        return True
-
-
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="a Linux parent-death signal")
 def test_a_node_whose_launcher_is_killed_gets_sigterm() -> None:
     """kill -9 of the launcher: its node is not left running unsupervised (it gets SIGTERM,
@@ -92,14 +84,14 @@ def test_a_node_whose_launcher_is_killed_gets_sigterm() -> None:
     try:
         assert launcher.stdout is not None
         node = int(launcher.stdout.readline())
-        assert not _ended(node)
+        assert alive(node)
         launcher.kill()
         launcher.wait(30)
-        assert wait_until(lambda: _ended(node), 30), "the node outlived its launcher"
+        assert wait_until(lambda: not alive(node), 30), "the node outlived its launcher"
     finally:
         if launcher.poll() is None:
             launcher.kill()
-        if node > 0 and not _ended(node):
+        if node > 0 and alive(node):
             os.kill(node, signal.SIGKILL)
 
 
