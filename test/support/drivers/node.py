@@ -42,7 +42,9 @@ TICKING = "ticking"  # the driver's first line once it ticks (``run.start`` wait
 ARM_JOINTS = tuple(f"joint{i}" for i in range(1, 8))
 GRIPPER = "gripper_finger_joint"  # an extra joint the arm's model does not have
 FD_JOINTS = ("fd_x", "fd_y", "fd_z")
-CATCH_UP = 20  # periods a late tick catches up; a longer stall moves the grid on
+#: periods a late tick steps the plant through unseen (``on_wakeup``); a longer stall moves the
+#: grid on, the plant held
+CATCH_UP = 20
 #: touch: when in a period (its shares) the driver looks for the answer to its newest state, to
 #: step the plant on it then rather than at the next instant, before that state goes out; on
 #: one CPU it does not look (each look's wakeup would take the loop's CPU)
@@ -167,10 +169,14 @@ class DriverNode(LoopNode):
             self._n += behind - CATCH_UP
             self.deadline += (behind - CATCH_UP) * self.period_s
             behind = CATCH_UP
-        for _ in range(behind + 1):  # every state of the grid goes out, stamped its instant
-            self._tick(now, publish=now >= self.paused_until)
+        # a real driver skips the cycles it overran, it does not run them back to back: Jazzy's
+        # controller_manager (``overruns.manage``, on by default) moves its next cycle to the
+        # grid's next instant, as rclcpp's timers and rates do. The device moves on meanwhile
+        for _ in range(behind):
+            self._tick(now, publish=False, missed=True)
+        self._tick(now, publish=now >= self.paused_until)
 
-    def _tick(self, now: float, publish: bool) -> None:
+    def _tick(self, now: float, publish: bool, missed: bool = False) -> None:
         """The cycle at grid instant ``self._n`` (deadline ``self.deadline``), processed at
         monotonic ``now``: first the commands DDS received before that instant (``Inbox``: a
         real driver's update does not wait for a late Python tick), then the state at the
@@ -179,12 +185,13 @@ class DriverNode(LoopNode):
         the command written then, as the device moves on its own while the driver waits; then
         it steps over the next period with this update's command. Touch: the newest force acts
         over the period before the instant: the plant stepped on the answer to the last state
-        when ``_look`` found it, else it steps now. A tick processed late
-        first catches up the ticks already due, their states going out at once, stamped their
-        instants (``CATCH_UP`` at most: then the grid moves on and states are lost)."""
+        when ``_look`` found it, else it steps now. A ``missed`` tick (a cycle the driver overran)
+        only moves the plant through its period with the command in force: no state goes out
+        and the controller's update does not run."""
         stamp = self._t0_ns + self._n * self.period_ns
         self.io.receive(stamp)  # the stamp is the tick's instant on the system clock
-        if self._k >= 0 and self.on_time and self._stamp not in (self._answered, self._marked):
+        answered = (self._answered, self._marked)
+        if not missed and self._k >= 0 and self.on_time and self._stamp not in answered:
             self._unanswered += 1
             self._marked = self._stamp
         self._looks = []
@@ -193,11 +200,11 @@ class DriverNode(LoopNode):
         self._ahead = False
         self._k += 1
         s = self.plant.sample()
-        if self.kind == "touch":
+        if self.kind == "touch" and not missed:
             self.io.press(self._button, stamp)
         if publish:
             self._publish(stamp, s)
-        if self.kind == "fd" or self.kind == "arm":
+        if (self.kind == "fd" or self.kind == "arm") and not missed:
             self._written = self.io.update()  # the controller's update: acts from this tick on
         applied = self._force if self.kind == "touch" else s.effort
         row = (stamp, now, float(publish), *s.q, *applied, *s.hand_force, *s.ee_position)
