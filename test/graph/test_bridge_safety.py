@@ -104,7 +104,7 @@ def test_driver_state_stops_zero_and_the_stale_state_is_not_rendered(tmp_path) -
     finally:
         controls.close()
         truth = run.finish()
-    paused = ~truth.published
+    paused = truth.paused
     assert paused.sum() >= 100, "the pause did not happen"
     # the premise: the quiet the test saw was the pause (not a stall of this process beside a
     # CPU hog), so that the loop insisted on the state before it for the whole 0.3 s

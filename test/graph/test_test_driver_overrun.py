@@ -45,7 +45,7 @@ def test_a_late_tick_skips_the_cycles_it_missed(context, tmp_path: Path, kind: s
         node.on_wakeup(first + 3.5 * node.period_s)  # instants 1 and 2 overrun, 3 due
         stamps = node.tick_stamps
         assert [b - a for a, b in pairwise(stamps)] == [node.period_ns] * 3
-        assert [row[2] for row in node.ticks] == [1.0, 0.0, 0.0, 1.0]  # published
+        assert [row[2] for row in node.ticks] == [1.0, -1.0, -1.0, 1.0]  # out; skipped
         assert node.states == 2 and node.missed_ticks == 2
     finally:
         node.destroy_node()

@@ -114,7 +114,8 @@ class DriverNode(LoopNode):
         #: the first state answered on time, the last state first answered from it on
         self._answered_from, self._answered_to = 2**63, -1
         self.latency = LatencyHistogram()  # s, a state going out -> its first answer received
-        #: per tick: stamp, monotonic s, published (1/0), q..., effort..., hand (3), tip (3)
+        #: per tick: stamp, monotonic s, went out (1; 0: the test's pause; -1: an overrun skipped
+        #: it), q..., effort..., hand (3), tip (3)
         self.ticks: list[tuple[float, ...]] = []
         self.commands: list[tuple[float, ...]] = []  # arrival (monotonic), stamp, values...
         self.tick_stamps: list[int] = []  # each tick's stamp, exact (ns)
@@ -207,7 +208,8 @@ class DriverNode(LoopNode):
         if (self.kind == "fd" or self.kind == "arm") and not missed:
             self._written = self.io.update()  # the controller's update: acts from this tick on
         applied = self._force if self.kind == "touch" else s.effort
-        row = (stamp, now, float(publish), *s.q, *applied, *s.hand_force, *s.ee_position)
+        went = -1.0 if missed else float(publish)  # out, held by the test's pause, skipped
+        row = (stamp, now, went, *s.q, *applied, *s.hand_force, *s.ee_position)
         self.ticks.append(row)
         self.tick_stamps.append(stamp)
         self.tick_late.append(now - self.deadline)
@@ -291,7 +293,7 @@ class DriverNode(LoopNode):
         return sum(
             1
             for row, st in zip(self.ticks, self.tick_stamps, strict=True)
-            if row[2] and first_ns <= st <= last_ns
+            if row[2] > 0 and first_ns <= st <= last_ns
         )
 
     @staticmethod

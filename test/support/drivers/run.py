@@ -168,7 +168,8 @@ class Controls:
 @dataclass(frozen=True)
 class Truth:
     """What a driver wrote when it stopped: its counts and plant, and per cycle and command
-    series (``ticks``: stamp ns, monotonic s, whether the state went out, q, the effort applied
+    series (``ticks``: stamp ns, monotonic s, whether the state went out (1; 0: the test's
+    pause held it; -1: the driver skipped the cycle, an overrun), q, the effort applied
     over the period before, hand force (3), tip (3); ``commands``: arrival (monotonic s), the
     stamp answered, values)."""
 
@@ -212,6 +213,11 @@ class Truth:
     @property
     def published(self) -> np.ndarray:
         return self.ticks[:, 2] > 0.5
+
+    @property
+    def paused(self) -> np.ndarray:
+        """Ticks whose state the test's pause held back (not those an overrun skipped)."""
+        return self.ticks[:, 2] == 0.0
 
     @property
     def q(self) -> np.ndarray:
