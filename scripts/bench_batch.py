@@ -11,7 +11,7 @@ import time
 import timeit
 
 from haptic_dob.bridge.velocity import KalmanVelocity, WindowVelocity
-from haptic_dob.core.models import SlideModel
+from haptic_dob.core.models import PointMassModel, SlideModel
 from haptic_dob.core.observers.disturbance import DisturbanceObserver
 from haptic_sim.slide.session import SessionConfig, run_session
 from haptic_sim.slide.stability import law_for
@@ -36,7 +36,8 @@ def bench_batch_session(repeat: int) -> str:
 
 
 def bench_observer_update(repeat: int) -> str:
-    """One slide observer update (validation, implicit update, clip): microseconds."""
+    """One slide observer update (validation, implicit update, clip), and one Force Dimension
+    point mass's (three axes) with the next update's preparation: microseconds."""
     obs = DisturbanceObserver(SlideModel(), 41.6, 1e-3, 4.0)
     q, qd, tau = (0.001,), (0.01,), (0.5,)
     obs.update(q, qd, tau)
@@ -44,7 +45,21 @@ def bench_observer_update(repeat: int) -> str:
     runs = [
         timeit.timeit(lambda: obs.update(q, qd, tau), number=n) / n * 1e6 for _ in range(repeat)
     ]
-    return f"median {statistics.median(runs):.2f} us per update (min {min(runs):.2f})"
+    fd = DisturbanceObserver(PointMassModel([0.2, 0.21, 0.22], 1.0, 0.1), 30.0, 1e-3, 4.0)
+    q3, qd3, tau3 = (0.001, 0.002, 0.003), (0.01, -0.02, 0.03), (0.5, -0.4, 0.3)
+
+    def cycle() -> None:
+        fd.update(q3, qd3, tau3)
+        fd.prepare()
+
+    cycle()
+    n3 = 20_000
+    runs3 = [timeit.timeit(cycle, number=n3) / n3 * 1e6 for _ in range(repeat)]
+    return (
+        f"slide: median {statistics.median(runs):.2f} us per update (min {min(runs):.2f}); "
+        f"point mass: median {statistics.median(runs3):.2f} us per update and preparation "
+        f"(min {min(runs3):.2f})"
+    )
 
 
 def bench_velocity(repeat: int) -> str:

@@ -120,3 +120,34 @@ def test_the_controller_commands_the_force_itself() -> None:
     ctl = ImpedanceController(model(), ImpedanceLaw("DOB", kf=1.0, max_force_n=12.0))
     wall, est = (0.0, 0.0, 2.5), (0.0, 0.1, -2.0)
     assert ctl.command([0.0, 0.0, 0.0], wall, f_estimated=est) == pytest.approx([0.0, 0.1, 3.0])
+
+
+class _Varying(PointMassModel):
+    """The same point mass, declared as if its D could change with q."""
+
+    constant_mass_matrix = False
+
+
+def test_the_observer_makes_its_step_once_and_estimates_exactly_the_same(monkeypatch) -> None:
+    """Its D is constant: the step's inverse is made once per gain, not every sample, and the
+    estimates equal those of an observer that remakes it every sample, bit for bit."""
+    params = ([0.2, 0.21, 0.22], [1.0, 1.1, 1.2], [0.1, 0.1, 0.1])
+    rng = np.random.default_rng(0)
+    samples = rng.normal(size=(200, 3, 3)) * (1e-3, 1e-2, 1.0)
+    inverses = []
+    real_inv = np.linalg.inv
+    monkeypatch.setattr(np.linalg, "inv", lambda a: inverses.append(1) or real_inv(a))
+    estimates = []
+    for model in (PointMassModel(*params), _Varying(*params)):
+        inverses.clear()
+        obs = DisturbanceObserver(model, 30.0, 1e-3, 4.0)
+        out = []
+        for k, (q, qd, tau) in enumerate(samples):
+            if k == 100:
+                obs.retune(20.0)  # a new gain: a new step
+            out.append(obs.update(q, qd, tau))
+            obs.prepare()
+        estimates.append(np.array(out))
+        made = len(inverses)  # one per gain, or one per sample (and the retune's)
+        assert made == 2 if model.constant_mass_matrix else made >= len(samples), made
+    assert np.array_equal(estimates[0], estimates[1])

@@ -31,6 +31,8 @@ class DeviceModel(ABC):
     joint_names: tuple[str, ...]
     #: True when J does not depend on q (a controller then needs no joint positions)
     constant_jacobian: bool = False
+    #: True when D does not depend on q (the observer then makes its step's matrices once)
+    constant_mass_matrix: bool = False
 
     # --- public, validated -------------------------------------------------------------------
     def mass_matrix(self, q: ArrayLike) -> Mat:

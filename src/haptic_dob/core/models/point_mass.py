@@ -48,6 +48,7 @@ class PointMassModel(DeviceModel):
 
     dof = 3
     constant_jacobian = True
+    constant_mass_matrix = True
 
     def __init__(
         self,

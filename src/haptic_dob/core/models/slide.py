@@ -30,6 +30,7 @@ class SlideModel(DeviceModel):
 
     dof = 1
     constant_jacobian = True
+    constant_mass_matrix = True
 
     def __init__(
         self,

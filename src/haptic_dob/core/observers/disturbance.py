@@ -184,7 +184,10 @@ class DisturbanceObserver:
         self._make_step()
 
     def _make_step(self) -> tuple[Mat, Mat]:
-        """``z_{k+1} = P z_k + Q r``: ``P = A^-1 D_k``, ``Q = T c A^-1``, ``A = D_k + T c I``."""
+        """``z_{k+1} = P z_k + Q r``: ``P = A^-1 D_k``, ``Q = T c A^-1``, ``A = D_k + T c I``;
+        made once for a model whose D is constant (until the gain or the state is reset)."""
+        if self._step is not None and self.model.constant_mass_matrix:
+            return self._step
         A_inv: Mat = np.linalg.inv(self._D_prev + self._tc_eye).astype(np.float64, copy=False)
         step: tuple[Mat, Mat] = (A_inv @ self._D_prev, (self.dt * self.gain) * A_inv)
         self._step = step
