@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 from ament_index_python.packages import get_package_prefix
 
-from support.rosgraph import isolated_env
+from support.rosgraph import isolated_env, private_context
 from support.waits import wait_until
 
 pytestmark = [pytest.mark.multiprocess]
@@ -30,13 +30,8 @@ EXECUTABLES = [
 def node_names(env: dict[str, str]) -> set[str]:
     """Names of the nodes visible on the domain (via a short-lived rclpy context)."""
     import rclpy
-    from rclpy.context import Context
 
-    saved = os.environ.get("ROS_DOMAIN_ID")
-    os.environ["ROS_DOMAIN_ID"] = env["ROS_DOMAIN_ID"]
-    ctx = Context()
-    rclpy.init(context=ctx, args=[])
-    try:
+    with private_context(domain=env["ROS_DOMAIN_ID"]) as ctx:
         probe = rclpy.create_node("probe", context=ctx)
 
         def names_now() -> set[str]:
@@ -46,12 +41,6 @@ def node_names(env: dict[str, str]) -> set[str]:
         names = names_now()
         probe.destroy_node()
         return names
-    finally:
-        rclpy.try_shutdown(context=ctx)
-        if saved is None:
-            os.environ.pop("ROS_DOMAIN_ID", None)
-        else:
-            os.environ["ROS_DOMAIN_ID"] = saved
 
 
 @pytest.mark.parametrize(("package", "name"), EXECUTABLES, ids=[e for _, e in EXECUTABLES])

@@ -10,10 +10,8 @@ import math
 
 import numpy as np
 import pytest
-import rclpy
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from rclpy.context import Context
 from rclpy.exceptions import ParameterNotDeclaredException
 from rclpy.parameter import Parameter
 
@@ -22,7 +20,7 @@ from haptic_dob.nodes.environment_node import EnvironmentNode
 from haptic_dob.nodes.observer_node import ObserverNode
 from haptic_msgs_py.values import EffortCommand
 from haptic_sim.nodes.device_node import DeviceNode
-from support.rosgraph import isolated_env
+from support.rosgraph import private_context
 
 SETTINGS = settings(
     max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
@@ -31,18 +29,8 @@ SETTINGS = settings(
 
 @pytest.fixture(scope="module")
 def context():
-    import os
-
-    saved = os.environ.get("ROS_DOMAIN_ID")
-    os.environ["ROS_DOMAIN_ID"] = isolated_env()["ROS_DOMAIN_ID"]
-    ctx = Context()
-    rclpy.init(context=ctx, args=["--ros-args", "-p", "clock_mode:=realtime"])
-    yield ctx
-    rclpy.try_shutdown(context=ctx)
-    if saved is None:
-        os.environ.pop("ROS_DOMAIN_ID", None)
-    else:
-        os.environ["ROS_DOMAIN_ID"] = saved
+    with private_context(["--ros-args", "-p", "clock_mode:=realtime"]) as ctx:
+        yield ctx
 
 
 values = st.one_of(

@@ -8,30 +8,19 @@ skipped periods with the command in force (docs/devices.md, "Tests without hardw
 
 from __future__ import annotations
 
-import os
 from itertools import pairwise
 from pathlib import Path
 
 import pytest
-import rclpy
-from rclpy.context import Context
 
 from support.drivers.node import DriverNode
-from support.rosgraph import isolated_env
+from support.rosgraph import private_context
 
 
 @pytest.fixture
 def context():
-    saved = os.environ.get("ROS_DOMAIN_ID")
-    os.environ["ROS_DOMAIN_ID"] = isolated_env()["ROS_DOMAIN_ID"]
-    ctx = Context()
-    rclpy.init(context=ctx, args=[])
-    yield ctx
-    rclpy.try_shutdown(context=ctx)
-    if saved is None:
-        os.environ.pop("ROS_DOMAIN_ID", None)
-    else:
-        os.environ["ROS_DOMAIN_ID"] = saved
+    with private_context() as ctx:
+        yield ctx
 
 
 @pytest.mark.parametrize("kind", ["fd", "arm", "touch"])

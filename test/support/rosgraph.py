@@ -16,7 +16,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -56,6 +56,27 @@ def isolated_env(domain: int | None = None) -> dict[str, str]:
     env["RCUTILS_LOGGING_BUFFERED_STREAM"] = "0"
     env.pop("ROS_STATIC_PEERS", None)
     return env
+
+
+@contextlib.contextmanager
+def private_context(args: Sequence[str] = (), domain: str | None = None) -> Iterator[Any]:
+    """An rclpy context of this process on ``domain`` (default: a random one; ``ROS_DOMAIN_ID``
+    set while it lives, then put back), initialised with ``args``; shut down on the way out."""
+    import rclpy  # lazy: tests that only start processes need no rclpy here
+    from rclpy.context import Context  # lazy: as above
+
+    saved = os.environ.get("ROS_DOMAIN_ID")
+    os.environ["ROS_DOMAIN_ID"] = domain or isolated_env()["ROS_DOMAIN_ID"]
+    ctx = Context()
+    try:
+        rclpy.init(context=ctx, args=list(args))
+        yield ctx
+    finally:
+        rclpy.try_shutdown(context=ctx)
+        if saved is None:
+            os.environ.pop("ROS_DOMAIN_ID", None)
+        else:
+            os.environ["ROS_DOMAIN_ID"] = saved
 
 
 def alive(pid: int) -> bool:
