@@ -66,7 +66,7 @@ def private_context(args: Sequence[str] = (), domain: str | None = None) -> Iter
     from rclpy.context import Context  # lazy: as above
 
     saved = os.environ.get("ROS_DOMAIN_ID")
-    os.environ["ROS_DOMAIN_ID"] = domain or isolated_env()["ROS_DOMAIN_ID"]
+    os.environ["ROS_DOMAIN_ID"] = domain or str(random_domain())
     ctx = Context()
     try:
         rclpy.init(context=ctx, args=list(args))
