@@ -3,15 +3,15 @@
 Each run starts a test driver (``test/support/drivers``, ``PROFILES``: Force Dimension-like at
 1 kHz, Touch-like at 500 Hz with the stylus button held, a Franka-like arm at 1 kHz as a
 teleoperation slave) and ``haptic-launch`` of its config for ``RUN_S`` seconds on a fresh domain
-id, with one raw hop (``dds_hop``) measured before and after. The driver measures what matters to
-a device: from publishing state k to receiving its first answer, whether command k came before
-state k+1's instant (on time), and whether the first answer came within a period of state k
-going out (what a driver that publishes at its instant gets: the Python driver is late at
-times, by the p99 given). The figure is that latency's median against the slower raw hop: the
-floor is two hops. ``GRAPH_ARGS`` go to ``haptic-launch``; with ``--rt-priority P`` the driver
-runs under SCHED_FIFO P too, as a controller manager runs (without it, under default
-scheduling, as the loop). ``CPUS`` (``--cpus LIST``): the driver and the loop under ``taskset -c
-LIST``, on the CPUs the machine stalls least (``timer-floor``; docs/running.md).
+id, one raw hop (``dds_hop``) measured before and after, and after it the raw answer's on-time
+share at the driver's rate (``answer_floor``: no work, the same scheduling). The driver measures
+from publishing state k to its first answer, whether command k came before state k+1's instant
+(on time) and whether the first answer came within a period of state k going out (what a driver
+that publishes at its instant gets: the Python driver is late at times, by the p99 given). The
+latency's median is set against the slower raw hop (floor: two hops), the on-time share against
+the raw answer's. ``GRAPH_ARGS`` go to ``haptic-launch``; with ``--rt-priority P`` the driver
+runs under SCHED_FIFO P too, as a controller manager runs. ``CPUS`` (``--cpus LIST``): the
+driver, the loop and the floor under ``taskset -c LIST`` (``timer-floor``; docs/running.md).
 """
 
 from __future__ import annotations
@@ -30,7 +30,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "test"))  # the test drivers live with the tests
 
-from bench_graph import GRAPH_ARGS  # noqa: E402
+from bench_answer_floor import graph_sched  # noqa: E402
+from bench_graph import GRAPH_ARGS, graph_option  # noqa: E402
+from haptic_dob.runtime.ros.answer_floor import answer_floor  # noqa: E402
 from haptic_dob.runtime.ros.dds_hop import hop_us  # noqa: E402
 from support.drivers.run import SLIDE_HAND, Controls, Truth, start  # noqa: E402
 
@@ -74,9 +76,7 @@ def cpus_prefix() -> list[str]:
 
 def driver_priority() -> int:
     """The driver's SCHED_FIFO priority: the graph's ``--rt-priority P``, else 0 (none)."""
-    if "--rt-priority" not in GRAPH_ARGS:
-        return 0
-    return int(GRAPH_ARGS[GRAPH_ARGS.index("--rt-priority") + 1])
+    return graph_option("--rt-priority") or 0
 
 
 def stop_group(proc: subprocess.Popen[bytes]) -> None:
@@ -134,12 +134,17 @@ def one_run(profile: str) -> dict[str, float]:
         truth = Truth.read(d / "driver")
         bridge = json.loads((d / "bridge.json").read_text())
     hop_after = hop_us(2000, domain_id=domain)
+    cpus = {int(c) for c in CPUS[0].split(",")} if CPUS else None
+    floor = answer_floor(
+        float(str(driver["rate_hz"])), RUN_S, sched=graph_sched(), domain_id=domain, cpus=cpus
+    )
     c = truth.counts
     return {
         "hop_us": max(hop_before, hop_after),
         "latency_p50_us": c["latency_p50_ms"] * 1e3,
         "latency_p99_us": c["latency_p99_ms"] * 1e3,
         "on_time_pct": 100.0 * c["commands_on_time"] / (c["commands_on_time"] + c["commands_late"]),
+        "raw_on_time_pct": floor.on_time_pct,
         "within_pct": 100.0 * c["commands_within_period"] / max(1, c["states_answered_span"]),
         "bridge_p50_us": bridge["latency_p50_ms"] * 1e3,
         "ticked_pct": 100.0 * truth.ticked_share(),
@@ -156,13 +161,15 @@ def bench_bridge(repeat: int) -> str:
         med = {k: statistics.median(r[k] for r in runs) for k in runs[0]}
         ratio = [r["latency_p50_us"] / r["hop_us"] for r in runs]
         on_time = ", ".join(f"{r['on_time_pct']:.2f}" for r in runs)
+        raw = ", ".join(f"{r['raw_on_time_pct']:.2f}" for r in runs)
         ticked = ", ".join(f"{r['ticked_pct']:.0f}" for r in runs)
         within = ", ".join(f"{r['within_pct']:.2f}" for r in runs)
         parts.append(
             f"{profile}: state->command p50 {med['latency_p50_us']:.0f} us "
             f"(p99 {med['latency_p99_us']:.0f}), {statistics.median(ratio):.1f}x one raw hop "
             f"({med['hop_us']:.0f} us; floor 2x), inside the bridge {med['bridge_p50_us']:.0f} "
-            f"us; on time {on_time} %; within a period of the state {within} %; driver ticked "
+            f"us; on time {on_time} % (raw answers {raw} %); within a period of the state "
+            f"{within} %; driver ticked "
             f"{ticked} % of its periods, p99 {med['tick_late_p99_us']:.0f} us after its instant, "
             f"its states out p50 {med['out_late_p50_us']:.0f} us after their instants"
         )

@@ -25,6 +25,11 @@ from bench_floors import around, summary
 GRAPH_ARGS: list[str] = []
 
 
+def graph_option(name: str) -> int | None:
+    """The value of a ``GRAPH_ARGS`` option given as ``NAME VALUE`` (None when absent)."""
+    return int(GRAPH_ARGS[GRAPH_ARGS.index(name) + 1]) if name in GRAPH_ARGS else None
+
+
 def graph_args(extra: list[str]) -> list[str]:
     """A benchmark's arguments and ``GRAPH_ARGS``; ``--pin`` only where every node has a process
     of its own (``--processes``): haptic-launch refuses it for nodes sharing a process."""

@@ -93,6 +93,11 @@ ROWS = [
          "benchmarks.py", "pattern", "--repeat", "3"),
     _row("floors", "this machine's own stalls: an idle loop per CPU waking every 1 ms for 20 s",
          "benchmarks.py", "timer-floor", "--repeat", "3"),
+    _row("floors", "the on-time floor: a driver-like process's state at each 1 kHz instant, "
+         "answered by a process that works before and after its answer (pure Python, as long "
+         "as given), 10 s, both under SCHED_FIFO 50 and PM QoS 0: answers before the next "
+         "instant", "benchmarks.py", "answer-floor", "--repeat", "5", "--rt-priority", "50",
+         "--cpu-latency", "0"),
     _row("lockstep", "default layout (the loop's four nodes in one process, `haptic-launch "
          "slide_sim`), DOB Kf = 1, 20 s simulated", "benchmarks.py", "lockstep", "--repeat",
          "3", *DOB),

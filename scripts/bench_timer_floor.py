@@ -13,7 +13,7 @@ import statistics
 import time
 from typing import Any
 
-from bench_graph import GRAPH_ARGS
+from bench_graph import graph_option
 from haptic_dob.runtime.cpu_latency import hold
 
 FLOOR_S = 20.0  # length of one timer-floor run (s), as the real-time graph runs
@@ -44,11 +44,6 @@ def _floor_loop(cpu: int, t0: float, priority: int | None, out: Any) -> None:
     out.put((cpu, late, longest))
 
 
-def _option(name: str) -> int | None:
-    """The value of a ``GRAPH_ARGS`` option given as ``NAME VALUE`` (None when absent)."""
-    return int(GRAPH_ARGS[GRAPH_ARGS.index(name) + 1]) if name in GRAPH_ARGS else None
-
-
 def bench_timer_floor(repeat: int) -> str:
     """What this machine allows any 1 kHz loop: one idle loop per CPU waking at every tick.
 
@@ -57,7 +52,7 @@ def bench_timer_floor(repeat: int) -> str:
     ``--cpu-latency`` when given (one loop per CPU, pinned, as ``--pin`` places the nodes).
     """
     ctx = multiprocessing.get_context("spawn")
-    prio, latency = _option("--rt-priority"), _option("--cpu-latency")
+    prio, latency = graph_option("--rt-priority"), graph_option("--cpu-latency")
     if prio is not None:  # refused here with the reason, not in each loop's process
         before = os.sched_getscheduler(0), os.sched_getparam(0)
         try:

@@ -16,8 +16,10 @@ from pathlib import Path
 
 # the benchmarks live beside this script by what they measure: bench_batch (the maths, in
 # process), bench_hop and bench_pattern (DDS floors), bench_graph (the launched node graph),
-# bench_timer_floor (the machine's own stalls), bench_margin (the graph against its floors)
+# bench_timer_floor (the machine's own stalls), bench_answer_floor (the on-time share any loop
+# of a given cost gets), bench_margin (the graph against its floors)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_answer_floor import bench_answer_floor
 from bench_batch import bench_batch_session, bench_observer_update, bench_velocity
 from bench_bridge import CPUS, ONLY, PROFILES, bench_bridge
 from bench_graph import (
@@ -62,6 +64,7 @@ BENCHMARKS: dict[str, Callable[[int], str]] = {
     "realtime-composed": bench_realtime_composed,
     "realtime-processes": bench_realtime_processes,
     "timer-floor": bench_timer_floor,
+    "answer-floor": bench_answer_floor,
     "hop": bench_hop,
     "pattern": bench_pattern,
     "margin": bench_margin,
@@ -99,7 +102,7 @@ def parser() -> argparse.ArgumentParser:
         type=int,
         metavar="US",
         help="hold a CPU wake-up latency request of US microseconds while the graph benchmarks "
-        "and timer-floor run (haptic-launch option; PM QoS, needs root)",
+        "and the floors run (haptic-launch option; PM QoS, needs root)",
     )
     p.add_argument(
         "--cpus",
