@@ -13,9 +13,7 @@ median speed), so it slows down with the machine as the loop's code does.
 
 from __future__ import annotations
 
-import multiprocessing
 import os
-import queue
 import random
 import statistics
 import struct
@@ -27,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from haptic_dob.runtime.cpu_latency import hold
-from haptic_dob.runtime.ros.dds_hop import peer_node
+from haptic_dob.runtime.ros.dds_hop import Peer, peer_node, run_peers
 from haptic_msgs_py import wire
 
 FLOOR_S = 10.0  # length of one run (s), as a bridge benchmark's session
@@ -164,25 +162,10 @@ def answer_floor(
     """One run at ``rate_hz`` for ``seconds``, the answerer's work ``work_us`` (before, after),
     both sides under ``sched`` (SCHED_FIFO priority, PM QoS latency us; None: not asked) on
     ``cpus`` (None: this process's), on ``domain_id`` (None: a random one of 101-200)."""
-    ctx = multiprocessing.get_context("spawn")
-    out = ctx.Queue()
     domain = str(random.randint(101, 200) if domain_id is None else domain_id)
-    loop = ctx.Process(target=_answerer, args=(domain, *work_us, seconds, (*sched, cpus)))
-    drv = ctx.Process(target=_driver, args=(domain, rate_hz, seconds, (*sched, cpus), out))
-    loop.start()
-    drv.start()
-    try:
-        sent, got, t0, period = out.get(timeout=seconds + 90.0)
-    except queue.Empty:
-        raise RuntimeError(f"the answer floor gave no result (exit code {drv.exitcode})") from None
-    finally:
-        drv.join(10.0)
-        loop.terminate()
-        loop.join(10.0)
-        for p in (drv, loop):
-            if p.is_alive():
-                p.kill()
-                p.join(5.0)
+    driver: Peer = (_driver, (domain, rate_hz, seconds, (*sched, cpus)))
+    answerer: Peer = (_answerer, (domain, *work_us, seconds, (*sched, cpus)))
+    sent, got, t0, period = run_peers(driver, answerer, seconds + 90.0, "the answer floor")
     kept = sorted(sent)[int(len(sent) * WARM_UP) :]
     if not kept:
         raise RuntimeError("the answer floor's driver sent no state")

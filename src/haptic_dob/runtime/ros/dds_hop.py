@@ -11,14 +11,17 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import queue
 import random
 import statistics
 import time
+from collections.abc import Callable
 from typing import Any
 
 from haptic_msgs_py import wire
 
 WARM_UP = 0.1  # share of the round trips left out at the start
+Peer = tuple[Callable[..., None], tuple[Any, ...]]  # a process's target and its arguments
 
 
 def peer_node(name: str, domain: str) -> tuple[Any, Any, Any]:
@@ -79,27 +82,37 @@ def _hop_peer(role: str, n: int, domain: str, out: Any) -> None:
     out.put(rtts)
 
 
+def run_peers(waiter: Peer, other: Peer, timeout_s: float, what: str) -> Any:
+    """Start ``other`` then ``waiter`` (each a target and its arguments) in spawned processes,
+    ``waiter`` given a result queue as its last argument; return the result it puts, then stop
+    both (``RuntimeError`` naming ``what`` when none comes within ``timeout_s``)."""
+    ctx = multiprocessing.get_context("spawn")
+    out = ctx.Queue()
+    second = ctx.Process(target=other[0], args=other[1])
+    second.start()
+    first = ctx.Process(target=waiter[0], args=(*waiter[1], out))
+    first.start()
+    try:
+        return out.get(timeout=timeout_s)
+    except queue.Empty:
+        raise RuntimeError(f"{what} gave no result (exit code {first.exitcode})") from None
+    finally:
+        first.join(10)
+        second.terminate()
+        second.join(10)
+        for p in (first, second):
+            if p.is_alive():
+                p.kill()
+                p.join(5)
+
+
 def hop_us(n: int = 3000, domain_id: int | None = None) -> float:
     """Median one-way latency (µs) of a small raw message between two rclpy processes: half the
     round trip of a ping-pong of ``n`` messages, the first 10 % left out (warm-up), on
     ``domain_id`` (None: a random one of 101-200)."""
-    ctx = multiprocessing.get_context("spawn")
-    out = ctx.Queue()
     domain = str(random.randint(101, 200) if domain_id is None else domain_id)
-    echo = ctx.Process(target=_hop_peer, args=("b", n, domain, out))
-    echo.start()
-    timer = ctx.Process(target=_hop_peer, args=("a", n, domain, out))
-    timer.start()
-    try:
-        rtts = out.get(timeout=120.0 + n * 0.01)
-    finally:
-        timer.join(10)
-        echo.terminate()
-        echo.join(10)
-        for p in (timer, echo):
-            if p.is_alive():
-                p.kill()
-                p.join(5)
+    echo: Peer = (_hop_peer, ("b", n, domain, None))
+    rtts = run_peers((_hop_peer, ("a", n, domain)), echo, 120.0 + n * 0.01, "the ping-pong")
     kept = rtts[int(len(rtts) * WARM_UP) :]
     if not kept:
         raise RuntimeError("the ping-pong got no answer")
