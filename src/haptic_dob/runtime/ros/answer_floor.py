@@ -82,7 +82,7 @@ def _scheduled(priority: int | None, latency: int | None, cpus: set[int] | None)
 
 def _answerer(domain: str, before_us: float, after_us: float, seconds: float, sched: Any) -> None:
     """The loop's side: each state in, ``before_us`` of work, its answer out, ``after_us``."""
-    held = _scheduled(*sched)  # noqa: F841 (the PM QoS request lasts while it is open)
+    _held = _scheduled(*sched)  # the PM QoS request lasts while it is open
     ctx, node, ex = peer_node("floor_loop", domain)
     # lazy: only the peer processes load rclpy
     from sensor_msgs.msg import JointState
@@ -106,7 +106,7 @@ def _answerer(domain: str, before_us: float, after_us: float, seconds: float, sc
 
 def _driver(domain: str, rate_hz: float, seconds: float, sched: Any, out: Any) -> None:
     """The driver's side: a state at each instant, the answers' receipt times kept."""
-    held = _scheduled(*sched)  # noqa: F841 (the PM QoS request lasts while it is open)
+    _held = _scheduled(*sched)  # the PM QoS request lasts while it is open
     _ctx, node, ex = peer_node("floor_driver", domain)
     # lazy: only the peer processes load rclpy
     from sensor_msgs.msg import JointState
