@@ -9,18 +9,13 @@ from __future__ import annotations
 
 import statistics
 
-from bench_graph import graph_option
+from bench_graph import graph_sched
 from haptic_dob.runtime.ros.answer_floor import FLOOR_S, answer_floor
 
 #: (before, after) the answer (us): none (the raw answer), about the Force Dimension DOB
 #: session's cycle without the recorder, and with it (docs/devices.md: the cycle's CPU p50
 #: 190-260 us before the command's send, the DDS take and write in it, 120-190 after)
 WORK_US: tuple[tuple[float, float], ...] = ((0.0, 0.0), (100.0, 50.0), (200.0, 150.0))
-
-
-def graph_sched() -> tuple[int | None, int | None]:
-    """The scheduling the graph benchmarks are given (``--rt-priority``, ``--cpu-latency``)."""
-    return graph_option("--rt-priority"), graph_option("--cpu-latency")
 
 
 def bench_answer_floor(repeat: int) -> str:

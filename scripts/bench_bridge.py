@@ -26,12 +26,12 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import cast
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "test"))  # the test drivers live with the tests
 
-from bench_answer_floor import graph_sched  # noqa: E402
-from bench_graph import GRAPH_ARGS, graph_option  # noqa: E402
+from bench_graph import GRAPH_ARGS, graph_option, graph_sched  # noqa: E402
 from haptic_dob.runtime.ros.answer_floor import answer_floor  # noqa: E402
 from haptic_dob.runtime.ros.dds_hop import hop_us  # noqa: E402
 from support.drivers.run import SLIDE_HAND, Controls, Truth, start  # noqa: E402
@@ -93,7 +93,8 @@ def stop_group(proc: subprocess.Popen[bytes]) -> None:
 
 
 def one_run(profile: str) -> dict[str, float]:
-    """One session of ``profile``: the driver's counts, the bridge's, and the raw hops."""
+    """One session of ``profile``: the driver's counts, the bridge's, the raw hops around it
+    and the raw answer's floor after it."""
     config, driver, bridge_name, extra = PROFILES[profile]
     domain = random.randint(101, 200)
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
@@ -136,7 +137,7 @@ def one_run(profile: str) -> dict[str, float]:
     hop_after = hop_us(2000, domain_id=domain)
     cpus = {int(c) for c in CPUS[0].split(",")} if CPUS else None
     floor = answer_floor(
-        float(str(driver["rate_hz"])), RUN_S, sched=graph_sched(), domain_id=domain, cpus=cpus
+        cast(float, driver["rate_hz"]), RUN_S, sched=graph_sched(), domain_id=domain, cpus=cpus
     )
     c = truth.counts
     return {

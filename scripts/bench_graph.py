@@ -30,6 +30,11 @@ def graph_option(name: str) -> int | None:
     return int(GRAPH_ARGS[GRAPH_ARGS.index(name) + 1]) if name in GRAPH_ARGS else None
 
 
+def graph_sched() -> tuple[int | None, int | None]:
+    """The scheduling the graph benchmarks are given (``--rt-priority``, ``--cpu-latency``)."""
+    return graph_option("--rt-priority"), graph_option("--cpu-latency")
+
+
 def graph_args(extra: list[str]) -> list[str]:
     """A benchmark's arguments and ``GRAPH_ARGS``; ``--pin`` only where every node has a process
     of its own (``--processes``): haptic-launch refuses it for nodes sharing a process."""

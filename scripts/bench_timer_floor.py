@@ -15,6 +15,7 @@ from typing import Any
 
 from bench_graph import graph_option
 from haptic_dob.runtime.cpu_latency import hold
+from haptic_dob.runtime.ros.answer_floor import check_sched
 
 FLOOR_S = 20.0  # length of one timer-floor run (s), as the real-time graph runs
 FLOOR_BUDGET_S = 0.5e-3  # a tick woken later than this counts as lost (s)
@@ -53,13 +54,7 @@ def bench_timer_floor(repeat: int) -> str:
     """
     ctx = multiprocessing.get_context("spawn")
     prio, latency = graph_option("--rt-priority"), graph_option("--cpu-latency")
-    if prio is not None:  # refused here with the reason, not in each loop's process
-        before = os.sched_getscheduler(0), os.sched_getparam(0)
-        try:
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(prio))
-        except (OSError, ValueError) as exc:
-            raise ValueError(f"SCHED_FIFO priority {prio} refused ({exc})") from None
-        os.sched_setscheduler(0, *before)
+    check_sched(prio, None)  # refused here with the reason, not in each loop's process
     cpus = sorted(os.sched_getaffinity(0))
     n = int(FLOOR_S * 1e3)
     shares, longest, stalls, per_cpu = [], [], [], []

@@ -85,17 +85,28 @@ def _hop_peer(role: str, n: int, domain: str, out: Any) -> None:
 def run_peers(waiter: Peer, other: Peer, timeout_s: float, what: str) -> Any:
     """Start ``other`` then ``waiter`` (each a target and its arguments) in spawned processes,
     ``waiter`` given a result queue as its last argument; return the result it puts, then stop
-    both (``RuntimeError`` naming ``what`` when none comes within ``timeout_s``)."""
+    both. ``RuntimeError`` naming ``what`` when either ends with no result, or none comes
+    within ``timeout_s``."""
     ctx = multiprocessing.get_context("spawn")
     out = ctx.Queue()
     second = ctx.Process(target=other[0], args=other[1])
     second.start()
     first = ctx.Process(target=waiter[0], args=(*waiter[1], out))
     first.start()
+    deadline = time.monotonic() + timeout_s
     try:
-        return out.get(timeout=timeout_s)
-    except queue.Empty:
-        raise RuntimeError(f"{what} gave no result (exit code {first.exitcode})") from None
+        while True:
+            try:
+                return out.get(timeout=0.5)
+            except queue.Empty:
+                pass
+            ended = [p.exitcode for p in (first, second) if p.exitcode is not None]
+            if ended or time.monotonic() > deadline:
+                try:
+                    return out.get(timeout=1.0)  # put just before its process ended
+                except queue.Empty:
+                    why = f"a process ended (exit code {ended[0]})" if ended else "timed out"
+                    raise RuntimeError(f"{what} gave no result: {why}") from None
     finally:
         first.join(10)
         second.terminate()
