@@ -166,7 +166,6 @@ def test_arm_as_teleoperation_slave_through_the_bridge(tmp_path) -> None:
     truth, counts = Truth.read(tmp_path / "driver"), json.loads(stats.read_text())
     hops.append(hop_floor_us())
     require_path_latency("arm", max(hops))
-    closes(truth, counts, 1000.0)
     est = {
         m.header.stamp.sec * 10**9 + m.header.stamp.nanosec: m.wrench.force.z
         for m in col.messages("wrench_estimate")
@@ -188,4 +187,5 @@ def test_arm_as_teleoperation_slave_through_the_bridge(tmp_path) -> None:
             f"state on this machine now (the estimate presumes {100 * ON_TIME:g} %); measured "
             f"anyway: the estimate {rms:.2f} N RMS in contact (bound {bound:.2f} N)"
         )
+    closes(truth, counts, 1000.0)  # after the premise: on one CPU beside the arm's own plant
     assert rms < bound, (rms, bound)

@@ -22,6 +22,7 @@ import os
 import random
 import sys
 import time
+from collections import deque
 from pathlib import Path
 from typing import Any
 
@@ -106,7 +107,10 @@ class DriverNode(LoopNode):
         self._sent_at: dict[int, int] = {}  # stamp -> system ns it went out, until answered
         self._answered = -1  # the newest stamp a command answered on time
         self.on_time = self.late = self.missed_ticks = self.states = 0
-        self._unanswered = 0  # states since the last on-time command: late once another comes
+        #: stamps of the states since the last on-time command: late once a command answers
+        #: one of them or a newer state (the loop was still answering, behind); the rest, after
+        #: the loop's last answer, are its end
+        self._unanswered: deque[int] = deque()
         self._marked = -1  # the newest state counted unanswered
         #: states whose first answer came within a period of the state going out: on time for
         #: a driver that publishes at its instant (this one is late at times)
@@ -135,8 +139,13 @@ class DriverNode(LoopNode):
         if stamp_ns == self._stamp and self._answered != self._stamp:
             self._answered = self._stamp
             self.on_time += 1
-            self.late, self._unanswered = self.late + self._unanswered, 0
+            self.late += len(self._unanswered)
+            self._unanswered.clear()
             self._answered_from = min(self._answered_from, stamp_ns)
+        elif stamp_ns is not None:  # a late answer: the states up to it were late, not the end
+            while self._unanswered and self._unanswered[0] <= stamp_ns:
+                self._unanswered.popleft()
+                self.late += 1
         sent = None if stamp_ns is None else self._sent_at.pop(stamp_ns, None)
         if stamp_ns is not None and sent is not None:  # the state's first answer
             age_s = (received_ns - sent) * 1e-9
@@ -193,7 +202,7 @@ class DriverNode(LoopNode):
         self.io.receive(stamp)  # the stamp is the tick's instant on the system clock
         answered = (self._answered, self._marked)
         if not missed and self._k >= 0 and self.on_time and self._stamp not in answered:
-            self._unanswered += 1
+            self._unanswered.append(self._stamp)
             self._marked = self._stamp
         self._looks = []
         if self.kind == "touch" and self._k >= 0 and not self._ahead:
@@ -311,8 +320,8 @@ class DriverNode(LoopNode):
             "ticks": self._k,
             "commands": len(self.commands),
             "commands_on_time": self.on_time,
-            "commands_late": self.late,  # between on-time ones: the loop's end is not late
-            "ticks_after_last_command": self._unanswered,
+            "commands_late": self.late,  # up to the loop's last answer: its end is not late
+            "ticks_after_last_command": len(self._unanswered),
             "commands_within_period": self.within_period,
             "states_answered_span": self._states_between(self._answered_from, self._answered_to),
             "missed_ticks": self.missed_ticks,
