@@ -5,7 +5,7 @@ its rate, under the scheduling the loop is given, skipping the periods it overra
 manager does; an answering process, as the bridge, takes it with an events executor, burns
 ``before_us`` of Python, answers, then burns ``after_us``. An answer is on time when DDS
 received it in the driver's process before the next instant: the bridge benchmark's criterion
-(its test drivers' ``Inbox``). With no work it is the raw answer's floor, the on-time
+(``haptic_msgs_py.ros.inbox``). With no work it is the raw answer's floor, the on-time
 counterpart of one raw hop; with a cycle's CPU, the share a loop of that cost gets here now.
 Both sides use the loop's QoS (``dds_hop``); the work is pure Python, calibrated at the
 process's start (its median speed), so it slows down with the machine as the loop's code does.
@@ -122,32 +122,28 @@ def _answerer(domain: str, before_us: float, after_us: float, seconds: float, sc
 def _driver(domain: str, rate_hz: float, seconds: float, sched: Any, out: Any) -> None:
     """The driver's side: a state at each instant; the answers read as a ros2_control update
     reads its commands, by DDS's reception time (system clock), from a subscription no executor
-    spins (the test drivers' ``Inbox``), so the driver's own wake-ups do not count."""
+    spins (``Inbox``, as the test drivers), so the driver's own wake-ups do not count."""
     _held = _scheduled(*sched)  # the PM QoS request lasts while it is open
-    ctx, node, _ex = peer_node("floor_driver", domain)
+    _ctx, node, _ex = peer_node("floor_driver", domain)
     # lazy: only the peer processes load rclpy
-    from rclpy.node import Node
     from sensor_msgs.msg import JointState
 
+    from haptic_msgs_py.ros.inbox import Inbox
     from haptic_msgs_py.ros.qos import LOOP, LOOP_IN_BEST_EFFORT
 
     msg = wire.joint_state(["fd_x", "fd_y", "fd_z"])
     msg.position = msg.velocity = msg.effort = np.array([0.01, -0.02, 0.03])
     state = bytearray(wire.encode(msg))
     pub = node.create_publisher(JointState, "floor_state", LOOP)
-    inbox = Node("floor_inbox", context=ctx)
-    sub = inbox.create_subscription(
-        JointState, "floor_answer", lambda _data: None, LOOP_IN_BEST_EFFORT, raw=True
-    )
+    inbox = Inbox(node, "sensor_msgs/msg/JointState", "floor_answer", LOOP_IN_BEST_EFFORT)
     got: dict[int, int] = {}  # state index -> its first answer's reception (system ns)
 
     def take() -> None:
-        with sub.handle:
-            while (m := sub.handle.take_message(sub.msg_type, True)) is not None:
-                got.setdefault(_SEQ.unpack_from(m[0], _SEQ_AT)[0], m[1]["received_timestamp"])
+        for received_ns, data in inbox.take():
+            got.setdefault(_SEQ.unpack_from(data, _SEQ_AT)[0], received_ns)
 
     end = time.monotonic() + 30.0
-    while pub.get_subscription_count() < 1 or not inbox.count_publishers("floor_answer"):
+    while pub.get_subscription_count() < 1 or not node.count_publishers("floor_answer"):
         if time.monotonic() > end:
             return
         time.sleep(0.01)
